@@ -1,0 +1,88 @@
+// Copyright wild_mvs authors. View images: loading, radiometry, bounded cache.
+//
+// Inside the core an image is a cv::Mat of type CV_32FC3, RGB channel order
+// (not OpenCV's BGR), linear radiometry (inverse sRGB applied once at load,
+// switchable), values nominally in [0, 1]. Row r, column c holds the pixel
+// whose centre is at (c + 0.5, r + 0.5) (camera.h).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <string>
+#include <utility>
+
+#include "wild_mvs/core/scene.h"
+
+namespace wild_mvs {
+
+struct ImageOptions {
+  // Apply the inverse sRGB transfer function at load (the paper matches in
+  // linear radiometric space).
+  bool linearize = true;
+  // Budget of the image cache in megabytes; least recently used images are
+  // evicted beyond it, so memory does not grow with the number of views.
+  double cache_mb = 1024;
+  // Images larger than this (longest side, pixels) are downscaled at load
+  // and the camera with them; 0 = no limit.
+  int max_image_size = 0;
+  void Check() const;
+};
+
+// sRGB <-> linear for one value in [0, 1].
+float SrgbToLinear(float v);
+float LinearToSrgb(float v);
+
+// Converts an 8/16-bit or float, 1/3/4-channel BGR(A) image as returned by
+// cv::imread into CV_32FC3 linear (or not) RGB in [0, 1].
+cv::Mat ToLinearRgb(const cv::Mat& bgr, bool linearize);
+
+// Loads a view's image from disk (8/16-bit, grey or colour; EXIF orientation
+// ignored), undistorts it when the view has lens distortion, checks that its
+// size matches the camera, and converts it with ToLinearRgb. Throws Error
+// naming the file and the problem (missing, unreadable, wrong size).
+cv::Mat LoadViewImage(const View& view, const ImageOptions& options);
+
+// Loads a view's mask (CV_8U, 0 = ignore) or returns an empty Mat when the
+// view has none. Throws Error when it is unreadable or of the wrong size.
+cv::Mat LoadViewMask(const View& view);
+
+// Thread-safe LRU cache of view images, bounded in bytes. Images come from a
+// loader function, so algorithms never see file paths and tests can feed
+// in-memory images.
+class ImageCache {
+ public:
+  using Loader = std::function<cv::Mat(int view)>;
+  ImageCache(Loader loader, double capacity_mb);
+
+  // The full-resolution image of `view`.
+  std::shared_ptr<const cv::Mat> Get(int view);
+  // The image of `view` resampled to width x height (area averaging when
+  // shrinking), cached separately.
+  std::shared_ptr<const cv::Mat> GetResized(int view, int width, int height);
+
+  size_t bytes() const;
+  size_t peak_bytes() const;
+
+ private:
+  using Key = std::pair<int, std::pair<int, int>>;  // view, (w, h); (0,0)=full
+  std::shared_ptr<const cv::Mat> Lookup(const Key& key);
+  void Insert(const Key& key, std::shared_ptr<const cv::Mat> img);
+
+  Loader loader_;
+  size_t capacity_bytes_;
+  mutable std::mutex mutex_;
+  std::list<std::pair<Key, std::shared_ptr<const cv::Mat>>> lru_;
+  std::map<Key, decltype(lru_)::iterator> index_;
+  size_t bytes_ = 0, peak_bytes_ = 0;
+};
+
+// A loader that reads scene views from disk with LoadViewImage.
+ImageCache::Loader MakeSceneLoader(const Scene& scene,
+                                   const ImageOptions& options);
+
+}  // namespace wild_mvs

@@ -1,0 +1,16 @@
+# Shared by the scripts: a sane PATH for Debian's ROS, the build folder, and
+# configure/build helpers. Source it; works from any current directory.
+# shellcheck shell=bash
+WILD_MVS_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+export PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin  # no pyenv python
+export ROS_HOSTNAME=${ROS_HOSTNAME:-localhost}
+export ROS_MASTER_URI=${ROS_MASTER_URI:-http://localhost:11311}
+BUILD_DIR="${BUILD_DIR:-$WILD_MVS_ROOT/build}"
+JOBS="${JOBS:-$(nproc)}"
+
+wild_mvs_build() {  # extra cmake args...
+  cmake -S "$WILD_MVS_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@" >"$BUILD_DIR.cmake.log" 2>&1 \
+    || { cat "$BUILD_DIR.cmake.log"; return 1; }
+  cmake --build "$BUILD_DIR" -j"$JOBS"
+}

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs what wild_mvs needs on Debian 12 (Debian's own ROS 1 packages), only when missing.
+# Usage: scripts/install_deps.sh [--no-ros] [--extra]
+#   --no-ros   only the ROS-free core, I/O and CLI dependencies
+#   --extra    also fuzzing/sanitizer (clang) and rviz/Xvfb screenshot tools
+set -eo pipefail
+export DEBIAN_FRONTEND=noninteractive
+CORE="build-essential cmake pkg-config git libgtest-dev libgmock-dev libeigen3-dev libopencv-dev \
+ libpcl-dev libyaml-cpp-dev libopenexr-dev"
+ROS="catkin ros-message-generation ros-message-runtime \
+ libroscpp-dev libstd-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev \
+ ros-std-msgs ros-sensor-msgs ros-geometry-msgs \
+ libcv-bridge-dev libimage-transport-dev libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev \
+ libpcl-conversions-dev libpcl-ros-dev librosbag-dev librostest-dev \
+ libnodelet-dev libmessage-filters-dev libimage-geometry-dev \
+ libdiagnostic-msgs-dev ros-diagnostic-msgs libdiagnostic-updater-dev \
+ libvisualization-msgs-dev ros-visualization-msgs libstd-srvs-dev ros-std-srvs \
+ ros-core rosbash python3-rostest python3-rospy python3-rosbag python3-std-msgs python3-sensor-msgs \
+ python3-geometry-msgs python3-numpy tf2-tools"
+EXTRA="clang libclang-rt-14-dev libfuzzer-14-dev rviz xvfb xauth"
+want="$CORE"
+for a in "$@"; do
+  case "$a" in
+    --no-ros) NO_ROS=1 ;;
+    --extra) want="$want $EXTRA" ;;
+    *) echo "install_deps.sh: unknown option '$a'" >&2; exit 2 ;;
+  esac
+done
+[ -n "${NO_ROS:-}" ] || want="$want $ROS"
+missing=""
+for p in $want; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "install_deps.sh: installing:$missing"
+  SUDO=""; [ "$(id -u)" = 0 ] || SUDO=sudo
+  $SUDO apt-get -o DPkg::Lock::Timeout=900 update -qq
+  $SUDO apt-get -o DPkg::Lock::Timeout=900 install -y -qq --no-install-recommends $missing >/dev/null
+fi

@@ -1,0 +1,196 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/core/image.h"
+
+#include <array>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "wild_mvs/core/error.h"
+
+namespace wild_mvs {
+
+void ImageOptions::Check() const {
+  Require(cache_mb > 0, "image.cache_mb = ", cache_mb, " must be > 0");
+  Require(max_image_size >= 0, "image.max_image_size = ", max_image_size,
+          " must be >= 0 (0 = no limit)");
+}
+
+float SrgbToLinear(float v) {
+  if (v <= 0.04045f) return v / 12.92f;
+  return std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+float LinearToSrgb(float v) {
+  if (v <= 0.0031308f) return 12.92f * v;
+  return 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+cv::Mat ToLinearRgb(const cv::Mat& in, bool linearize) {
+  Require(!in.empty(), "ToLinearRgb: empty image");
+  cv::Mat rgb;
+  switch (in.channels()) {
+    case 1:
+      cv::cvtColor(in, rgb, cv::COLOR_GRAY2RGB);
+      break;
+    case 3:
+      cv::cvtColor(in, rgb, cv::COLOR_BGR2RGB);
+      break;
+    case 4:
+      cv::cvtColor(in, rgb, cv::COLOR_BGRA2RGB);
+      break;
+    default:
+      throw Error(Msg("ToLinearRgb: unsupported channel count ",
+                      in.channels()));
+  }
+  cv::Mat out;
+  switch (rgb.depth()) {
+    case CV_8U: {
+      if (linearize) {
+        // Lookup table: exact and fast for 8-bit input.
+        std::array<float, 256> lut;
+        for (int i = 0; i < 256; ++i) lut[i] = SrgbToLinear(i / 255.0f);
+        out.create(rgb.size(), CV_32FC3);
+        for (int r = 0; r < rgb.rows; ++r) {
+          const uint8_t* s = rgb.ptr<uint8_t>(r);
+          float* d = out.ptr<float>(r);
+          for (int i = 0; i < rgb.cols * 3; ++i) d[i] = lut[s[i]];
+        }
+        return out;
+      }
+      rgb.convertTo(out, CV_32FC3, 1.0 / 255.0);
+      return out;
+    }
+    case CV_16U:
+      rgb.convertTo(out, CV_32FC3, 1.0 / 65535.0);
+      break;
+    case CV_32F:
+      out = rgb;
+      break;
+    default:
+      rgb.convertTo(out, CV_32FC3);
+      break;
+  }
+  if (linearize) {
+    out.forEach<cv::Vec3f>([](cv::Vec3f& p, const int*) {
+      for (int c = 0; c < 3; ++c) p[c] = SrgbToLinear(std::max(0.0f, p[c]));
+    });
+  }
+  return out;
+}
+
+cv::Mat LoadViewImage(const View& view, const ImageOptions& options) {
+  Require(!view.image_path.empty(), "image '", view.name,
+          "': no image file is known for this view");
+  cv::Mat raw = cv::imread(view.image_path,
+                           cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
+  Require(!raw.empty(), view.image_path,
+          ": cannot read image (missing, truncated or not an image)");
+  const Camera& cam = view.camera;
+  const int fw = view.file_width > 0 ? view.file_width : cam.width;
+  const int fh = view.file_height > 0 ? view.file_height : cam.height;
+  Require(raw.cols == fw && raw.rows == fh, view.image_path, ": image is ",
+          raw.cols, "x", raw.rows, " but its camera says ", fw, "x", fh);
+  if (!view.distortion.IsNone()) {
+    // Distortion parameters refer to the file's resolution.
+    const Camera fc = cam.Resized(fw, fh);
+    // OpenCV puts the top-left pixel centre at (0, 0): shift by 0.5.
+    cv::Mat K = (cv::Mat_<double>(3, 3) << fc.fx, 0, fc.cx - 0.5, 0, fc.fy,
+                 fc.cy - 0.5, 0, 0, 1);
+    const Distortion& d = view.distortion;
+    cv::Mat dist = (cv::Mat_<double>(1, 5) << d.k1, d.k2, d.p1, d.p2, d.k3);
+    cv::Mat und;
+    cv::undistort(raw, und, K, dist, K);
+    raw = und;
+  }
+  if (raw.cols != cam.width || raw.rows != cam.height) {
+    cv::Mat small;
+    cv::resize(raw, small, cv::Size(cam.width, cam.height), 0, 0,
+               cv::INTER_AREA);
+    raw = small;
+  }
+  return ToLinearRgb(raw, options.linearize);
+}
+
+cv::Mat LoadViewMask(const View& view) {
+  if (view.mask_path.empty()) return cv::Mat();
+  cv::Mat m = cv::imread(view.mask_path, cv::IMREAD_GRAYSCALE);
+  Require(!m.empty(), view.mask_path, ": cannot read mask image");
+  Require(m.cols == view.camera.width && m.rows == view.camera.height,
+          view.mask_path, ": mask is ", m.cols, "x", m.rows, " but image '",
+          view.name, "' is ", view.camera.width, "x", view.camera.height);
+  return m;
+}
+
+ImageCache::ImageCache(Loader loader, double capacity_mb)
+    : loader_(std::move(loader)),
+      capacity_bytes_(static_cast<size_t>(capacity_mb * 1024.0 * 1024.0)) {}
+
+std::shared_ptr<const cv::Mat> ImageCache::Lookup(const Key& key) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = index_.find(key);
+  if (it == index_.end()) return nullptr;
+  lru_.splice(lru_.begin(), lru_, it->second);
+  return it->second->second;
+}
+
+void ImageCache::Insert(const Key& key, std::shared_ptr<const cv::Mat> img) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (index_.count(key)) return;  // another thread loaded it meanwhile
+  lru_.emplace_front(key, img);
+  index_[key] = lru_.begin();
+  bytes_ += img->total() * img->elemSize();
+  peak_bytes_ = std::max(peak_bytes_, bytes_);
+  while (bytes_ > capacity_bytes_ && lru_.size() > 1) {
+    auto& back = lru_.back();
+    bytes_ -= back.second->total() * back.second->elemSize();
+    index_.erase(back.first);
+    lru_.pop_back();
+  }
+}
+
+std::shared_ptr<const cv::Mat> ImageCache::Get(int view) {
+  const Key key{view, {0, 0}};
+  if (auto hit = Lookup(key)) return hit;
+  auto img = std::make_shared<const cv::Mat>(loader_(view));
+  Insert(key, img);
+  return img;
+}
+
+std::shared_ptr<const cv::Mat> ImageCache::GetResized(int view, int width,
+                                                      int height) {
+  auto full = Get(view);
+  if (full->cols == width && full->rows == height) return full;
+  const Key key{view, {width, height}};
+  if (auto hit = Lookup(key)) return hit;
+  cv::Mat out;
+  const bool shrink = width < full->cols;
+  cv::resize(*full, out, cv::Size(width, height), 0, 0,
+             shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
+  auto img = std::make_shared<const cv::Mat>(std::move(out));
+  Insert(key, img);
+  return img;
+}
+
+size_t ImageCache::bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return bytes_;
+}
+
+size_t ImageCache::peak_bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return peak_bytes_;
+}
+
+ImageCache::Loader MakeSceneLoader(const Scene& scene,
+                                   const ImageOptions& options) {
+  const Scene* s = &scene;
+  return [s, options](int view) {
+    Require(view >= 0 && view < static_cast<int>(s->views.size()),
+            "image cache: no view ", view);
+    return LoadViewImage(s->views[view], options);
+  };
+}
+
+}  // namespace wild_mvs
