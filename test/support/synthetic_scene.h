@@ -1,0 +1,108 @@
+// Copyright wild_mvs authors. A small ray-casting renderer for tests.
+//
+// Builds scenes with exact ground truth: textured planes, slanted planes,
+// boxes and spheres, cameras around them, per-view exposure, white balance
+// and gamma changes, and occluders that appear in one view only. Every
+// algorithm test builds on it.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "wild_mvs/core/image.h"
+#include "wild_mvs/core/point_cloud.h"
+#include "wild_mvs/core/scene.h"
+
+namespace wild_mvs {
+namespace testing {
+
+struct SyntheticObject {
+  enum class Type { kPlane, kBox, kSphere };
+  Type type = Type::kPlane;
+  // kPlane: a rectangle centred at `center` spanned by the unit vectors
+  //   axis_u, axis_v with half extents size.x(), size.y().
+  // kBox: axis-aligned box centred at `center` (rotated by `rotation`),
+  //   half extents size.
+  // kSphere: centre `center`, radius size.x().
+  Eigen::Vector3d center{0, 0, 0};
+  Eigen::Vector3d size{1, 1, 1};
+  Eigen::Vector3d axis_u{1, 0, 0}, axis_v{0, 1, 0};
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  // Procedural texture (multi-scale value noise, colour) with this seed and
+  // feature size in world units; texture is fixed to the surface.
+  int texture_seed = 1;
+  double texture_scale = 0.05;
+  // -1: visible in every view. Otherwise the object exists only when
+  // rendering view `only_in_view` (a transient occluder: a person, a car);
+  // the ground-truth depth of that view includes it, of other views not.
+  int only_in_view = -1;
+};
+
+// Photometric change applied to one view's rendered linear radiance L:
+// out = clamp(exposure * white_balance[c] * L)^(1/gamma) + noise (then
+// quantised to 8 bits if quantize). gamma = 1 keeps the image linear.
+struct ViewLighting {
+  double exposure = 1.0;
+  Eigen::Vector3d white_balance{1, 1, 1};
+  double gamma = 1.0;
+};
+
+struct SyntheticSpec {
+  std::vector<SyntheticObject> objects;
+  int width = 320, height = 240;
+  double focal = 300;  // pixels; principal point at the image centre
+  // Camera centres; every camera looks at `look_at`, its image x axis
+  // horizontal (world z is up). See MakeRingCameras.
+  std::vector<Eigen::Vector3d> camera_centers;
+  Eigen::Vector3d look_at{0, 0, 0};
+  std::vector<ViewLighting> lighting;  // per view; empty = all defaults
+  double noise_sigma = 0.0;            // Gaussian image noise (linear units)
+  bool quantize = true;                // 8-bit quantisation like a camera
+  int supersample = 2;                 // anti-aliasing samples per axis
+  // Sparse points: sample this many surface points visible in >= 2 views,
+  // with exact projections as observations (feature scale = 2 px) and this
+  // much pixel noise on the observations.
+  int num_sparse_points = 300;
+  double sparse_pixel_noise = 0.0;
+  unsigned seed = 7;
+};
+
+struct SyntheticScene {
+  Scene scene;                  // cameras, view names "view_000.png"...,
+                                // no image paths; sparse points + tracks
+  std::vector<cv::Mat> images;  // CV_32FC3 linear RGB (as ImageCache gives)
+  std::vector<cv::Mat> depth;   // CV_32F exact z; 0 where nothing is hit
+  std::vector<cv::Mat> normals;  // CV_32FC3 camera frame, facing the camera
+  double scene_size = 1.0;       // diameter of the objects' bounding sphere
+
+  // A loader for ImageCache serving `images`.
+  ImageCache::Loader Loader() const;
+  // Points sampled on the visible surfaces (union over views of the
+  // ground-truth depth maps, one point per `stride` pixels) with normals.
+  PointCloud GroundTruthCloud(int stride = 2) const;
+};
+
+SyntheticScene Render(const SyntheticSpec& spec);
+
+// `n` cameras on a circle of `radius` at `height` around the origin, looking
+// at the origin (an object ring like Middlebury's).
+std::vector<Eigen::Vector3d> MakeRingCameras(int n, double radius,
+                                             double height, double arc_deg = 360);
+// Presets used by many tests.
+// A textured plane at depth ~2 slanted by `slant_deg` about the vertical
+// axis, seen by `n` cameras on a short arc in front of it.
+SyntheticSpec SlantedPlaneSpec(double slant_deg = 30, int n = 5);
+// Boxes and a sphere on a ground plane, 8 ring cameras, with per-view
+// exposure / white-balance / gamma changes when `vary_lighting`, and an
+// occluder present in view 0 only when `occluder`.
+SyntheticSpec ClutteredSceneSpec(bool vary_lighting, bool occluder);
+
+// Writes the scene as a dataset folder that the CLI reads: COLMAP text model
+// in DIR/sparse/ (cameras.txt, images.txt, points3D.txt), 8-bit sRGB PNG
+// images in DIR/images/, ground-truth depth as PFM in DIR/gt_depth/<stem>.pfm.
+void WriteDataset(const SyntheticScene& s, const std::string& dir);
+
+}  // namespace testing
+}  // namespace wild_mvs
