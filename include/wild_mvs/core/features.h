@@ -1,0 +1,71 @@
+// Copyright wild_mvs authors. SIFT features of one view, stored compactly.
+//
+// Keypoint positions are in the pixel convention of camera.h (the top-left
+// pixel's centre is (0.5, 0.5)): OpenCV puts pixel centres at integer
+// coordinates, so 0.5 is added, and positions found on a downscaled image are
+// mapped back to the full-resolution view. The scale is the SIFT keypoint
+// size (diameter of the meaningful neighbourhood) in full-resolution pixels;
+// global view selection uses it as the feature scale.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace wild_mvs {
+
+struct FeatureOptions {
+  // Keep at most this many features per view (strongest response first);
+  // bounds memory (128 bytes per descriptor) and matching time. 0 = no cap.
+  int max_features = 4000;
+  // OpenCV SIFT contrastThreshold (OpenCV's default 0.04; lower finds more
+  // features on weakly textured objects such as the Middlebury plaster
+  // models).
+  double contrast_threshold = 0.02;
+  // OpenCV SIFT edgeThreshold (OpenCV default).
+  double edge_threshold = 10;
+  // OpenCV SIFT nOctaveLayers and sigma (Lowe's values).
+  int octave_layers = 3;
+  double sigma = 1.6;
+  // Features are detected on the image shrunk by this factor (>= 1) when
+  // views are large; positions and scales are reported in full-resolution
+  // pixels.
+  double downscale = 1.0;
+  // Images inside the core are linear; SIFT's thresholds are tuned for
+  // display-encoded images, so the grey image is sRGB-encoded first.
+  bool srgb_encode = true;
+  // RootSIFT descriptors (Arandjelovic & Zisserman 2012: L1-normalise, square
+  // root), which match better than plain SIFT under the L2 distance.
+  bool root_sift = true;
+  void Check() const;
+};
+
+// Features of one view. Descriptors are 128 bytes each (CV_8U), unit L2 norm
+// scaled by kDescriptorScale, so the L2 distance of two normalised
+// descriptors is sqrt(sum (a - b)^2) / kDescriptorScale.
+struct Features {
+  static constexpr float kDescriptorScale = 512.0f;
+  std::vector<Eigen::Vector2f> xy;  // pixel coordinates (camera.h)
+  std::vector<float> scale;         // SIFT size in full-resolution pixels
+  std::vector<Eigen::Matrix<uint8_t, 3, 1>> rgb;  // sRGB colour at xy
+  cv::Mat descriptors;                            // size() x 128, CV_8U
+
+  int size() const { return static_cast<int>(xy.size()); }
+  size_t bytes() const;
+  // Keeps the features whose index is in `keep` (in that order).
+  void Select(const std::vector<int>& keep);
+};
+
+// Extracts SIFT features from an image: CV_32FC3 linear RGB in [0, 1] (the
+// core's image type), CV_32FC1 linear grey, or CV_8UC1 grey (taken as
+// display-encoded). `mask` (optional, CV_8U, same size, 0 = ignore) limits
+// where features are detected. Deterministic. Throws Error on a bad image.
+Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
+                         const cv::Mat& mask = cv::Mat());
+
+// Squared L2 distance of two descriptors (rows of Features::descriptors).
+int DescriptorDistanceSquared(const uint8_t* a, const uint8_t* b);
+
+}  // namespace wild_mvs

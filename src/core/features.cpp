@@ -1,0 +1,199 @@
+// Copyright wild_mvs authors. SIFT features of one view.
+#include "wild_mvs/core/features.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/image.h"
+
+namespace wild_mvs {
+
+void FeatureOptions::Check() const {
+  Require(max_features >= 0, "features.max_features = ", max_features,
+          " must be >= 0 (0 = no cap)");
+  Require(contrast_threshold > 0 && contrast_threshold < 1,
+          "features.contrast_threshold = ", contrast_threshold,
+          " must be in (0, 1)");
+  Require(edge_threshold > 0, "features.edge_threshold = ", edge_threshold,
+          " must be > 0");
+  Require(octave_layers >= 1 && octave_layers <= 10,
+          "features.octave_layers = ", octave_layers, " must be in [1, 10]");
+  Require(sigma > 0 && sigma < 10, "features.sigma = ", sigma,
+          " must be in (0, 10)");
+  Require(downscale >= 1 && downscale <= 64, "features.downscale = ", downscale,
+          " must be in [1, 64]");
+}
+
+size_t Features::bytes() const {
+  return xy.capacity() * sizeof(Eigen::Vector2f) +
+         scale.capacity() * sizeof(float) +
+         rgb.capacity() * sizeof(Eigen::Matrix<uint8_t, 3, 1>) +
+         descriptors.total() * descriptors.elemSize();
+}
+
+void Features::Select(const std::vector<int>& keep) {
+  Features out;
+  out.xy.reserve(keep.size());
+  out.scale.reserve(keep.size());
+  out.rgb.reserve(keep.size());
+  out.descriptors.create(static_cast<int>(keep.size()), 128, CV_8U);
+  for (size_t i = 0; i < keep.size(); ++i) {
+    const int k = keep[i];
+    out.xy.push_back(xy[k]);
+    out.scale.push_back(scale[k]);
+    if (!rgb.empty()) out.rgb.push_back(rgb[k]);
+    descriptors.row(k).copyTo(out.descriptors.row(static_cast<int>(i)));
+  }
+  *this = std::move(out);
+}
+
+int DescriptorDistanceSquared(const uint8_t* a, const uint8_t* b) {
+  int sum = 0;
+  for (int i = 0; i < 128; ++i) {
+    const int d = static_cast<int>(a[i]) - static_cast<int>(b[i]);
+    sum += d * d;
+  }
+  return sum;
+}
+
+namespace {
+
+// Display-encoded 8-bit grey image for detection.
+cv::Mat ToGrey8(const cv::Mat& image, bool srgb_encode) {
+  if (image.type() == CV_8UC1) return image;
+  cv::Mat grey;
+  if (image.type() == CV_32FC3) {
+    cv::cvtColor(image, grey, cv::COLOR_RGB2GRAY);
+  } else if (image.type() == CV_32FC1) {
+    grey = image;
+  } else {
+    throw Error(Msg("ExtractFeatures: unsupported image type ", image.type(),
+                    " (want CV_32FC3 linear RGB, CV_32FC1 or CV_8UC1)"));
+  }
+  cv::Mat out(grey.size(), CV_8UC1);
+  // Lookup-free per-pixel encode; fast enough next to SIFT itself.
+  for (int r = 0; r < grey.rows; ++r) {
+    const float* in = grey.ptr<float>(r);
+    uint8_t* o = out.ptr<uint8_t>(r);
+    for (int c = 0; c < grey.cols; ++c) {
+      float v = std::min(1.0f, std::max(0.0f, in[c]));
+      if (!(v == v)) v = 0;
+      if (srgb_encode) v = LinearToSrgb(v);
+      o[c] = static_cast<uint8_t>(std::lround(v * 255.0f));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
+                         const cv::Mat& mask) {
+  options.Check();
+  Require(!image.empty(), "ExtractFeatures: empty image");
+  Require(
+      mask.empty() || (mask.type() == CV_8UC1 && mask.size() == image.size()),
+      "ExtractFeatures: mask must be CV_8UC1 of the image size");
+  const cv::Mat grey_full = ToGrey8(image, options.srgb_encode);
+  cv::Mat grey = grey_full;
+  cv::Mat det_mask = mask;
+  double s = 1.0;  // full-resolution pixels per detection pixel
+  if (options.downscale > 1.0) {
+    const int w = std::max(
+        1, static_cast<int>(std::lround(grey.cols / options.downscale)));
+    const int h = std::max(
+        1, static_cast<int>(std::lround(grey.rows / options.downscale)));
+    cv::Mat small;
+    cv::resize(grey, small, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+    grey = small;
+    if (!mask.empty()) {
+      cv::resize(mask, det_mask, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
+    }
+    s = static_cast<double>(image.cols) /
+        w;  // equal to rows / h up to rounding
+  }
+  const double sy = options.downscale > 1.0
+                        ? static_cast<double>(image.rows) / grey.rows
+                        : 1.0;
+
+  // nfeatures = 0: detect all, then keep the strongest ourselves with a
+  // deterministic tie-break (position).
+  cv::Ptr<cv::SIFT> sift =
+      cv::SIFT::create(0, options.octave_layers, options.contrast_threshold,
+                       options.edge_threshold, options.sigma, CV_32F);
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  sift->detectAndCompute(grey, det_mask, kps, desc);
+
+  std::vector<int> order(kps.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&kps](int a, int b) {
+    if (kps[a].response != kps[b].response)
+      return kps[a].response > kps[b].response;
+    if (kps[a].pt.y != kps[b].pt.y) return kps[a].pt.y < kps[b].pt.y;
+    return kps[a].pt.x < kps[b].pt.x;
+  });
+  if (options.max_features > 0 &&
+      static_cast<int>(order.size()) > options.max_features) {
+    order.resize(options.max_features);
+  }
+
+  Features f;
+  const int n = static_cast<int>(order.size());
+  f.xy.reserve(n);
+  f.scale.reserve(n);
+  f.rgb.reserve(n);
+  f.descriptors.create(n, 128, CV_8U);
+  const bool colour = image.type() == CV_32FC3;
+  for (int i = 0; i < n; ++i) {
+    const cv::KeyPoint& kp = kps[order[i]];
+    // OpenCV: pixel centre at integer coordinates -> +0.5 (camera.h); then
+    // scale edge-based coordinates to full resolution.
+    const float x = static_cast<float>((kp.pt.x + 0.5) * s);
+    const float y = static_cast<float>((kp.pt.y + 0.5) * sy);
+    f.xy.emplace_back(x, y);
+    f.scale.push_back(static_cast<float>(kp.size * 0.5 * (s + sy)));
+    // Colour at the nearest full-resolution pixel.
+    const int col = std::min(image.cols - 1, std::max(0, static_cast<int>(x)));
+    const int row = std::min(image.rows - 1, std::max(0, static_cast<int>(y)));
+    Eigen::Matrix<uint8_t, 3, 1> rgb;
+    if (colour) {
+      const cv::Vec3f& p = image.at<cv::Vec3f>(row, col);
+      for (int c = 0; c < 3; ++c) {
+        float v = std::min(1.0f, std::max(0.0f, p[c]));
+        if (options.srgb_encode) v = LinearToSrgb(v);
+        rgb(c) = static_cast<uint8_t>(std::lround(v * 255.0f));
+      }
+    } else {
+      rgb.setConstant(grey_full.at<uint8_t>(row, col));
+    }
+    f.rgb.push_back(rgb);
+
+    // Normalise (RootSIFT or L2), store as bytes scaled by kDescriptorScale.
+    const float* d = desc.ptr<float>(order[i]);
+    float v[128];
+    if (options.root_sift) {
+      double l1 = 0;
+      for (int k = 0; k < 128; ++k) l1 += std::abs(d[k]);
+      for (int k = 0; k < 128; ++k)
+        v[k] = l1 > 0 ? static_cast<float>(std::sqrt(std::abs(d[k]) / l1)) : 0;
+    } else {
+      double l2 = 0;
+      for (int k = 0; k < 128; ++k) l2 += static_cast<double>(d[k]) * d[k];
+      const double inv = l2 > 0 ? 1.0 / std::sqrt(l2) : 0;
+      for (int k = 0; k < 128; ++k) v[k] = static_cast<float>(d[k] * inv);
+    }
+    uint8_t* o = f.descriptors.ptr<uint8_t>(i);
+    for (int k = 0; k < 128; ++k) {
+      o[k] = static_cast<uint8_t>(
+          std::min(255L, std::lround(v[k] * Features::kDescriptorScale)));
+    }
+  }
+  return f;
+}
+
+}  // namespace wild_mvs
