@@ -40,9 +40,15 @@ struct SyntheticObject {
   int only_in_view = -1;
 };
 
-// Photometric change applied to one view's rendered linear radiance L:
-// out = clamp(exposure * white_balance[c] * L)^(1/gamma) + noise (then
-// quantised to 8 bits if quantize). gamma = 1 keeps the image linear.
+// Photometric change applied to one view's rendered linear radiance L
+// (L = mean over the supersample^2 sub-pixel rays; radiance is view
+// independent and lies in about [0.02, 0.4]; background = 0). Per channel c:
+//   v = clamp(exposure * white_balance[c] * L, 0, 1) ^ (1 / gamma)
+//   v = clamp(v + N(0, noise_sigma), 0, 1)
+//   if quantize: v = SrgbToLinear(round(LinearToSrgb(v) * 255) / 255)
+// i.e. 8-bit quantisation happens in the sRGB encoding, as a camera's PNG or
+// JPEG stores it, so `images` equal exactly what LoadViewImage returns for
+// the 8-bit sRGB PNGs WriteDataset writes. gamma = 1 keeps it linear.
 struct ViewLighting {
   double exposure = 1.0;
   Eigen::Vector3d white_balance{1, 1, 1};
@@ -70,17 +76,24 @@ struct SyntheticSpec {
 };
 
 struct SyntheticScene {
-  Scene scene;                  // cameras, view names "view_000.png"...,
-                                // no image paths; sparse points + tracks
-  std::vector<cv::Mat> images;  // CV_32FC3 linear RGB (as ImageCache gives)
-  std::vector<cv::Mat> depth;   // CV_32F exact z; 0 where nothing is hit
+  Scene scene;                   // cameras, view names "view_000.png"...,
+                                 // no image paths; sparse points + tracks
+  std::vector<cv::Mat> images;   // CV_32FC3 linear RGB (as ImageCache gives)
+  std::vector<cv::Mat> depth;    // CV_32F exact z; 0 where nothing is hit
   std::vector<cv::Mat> normals;  // CV_32FC3 camera frame, facing the camera
-  double scene_size = 1.0;       // diameter of the objects' bounding sphere
+  double scene_size = 1.0;       // diagonal of the bounding box of the
+                                 // objects (excluding one-view occluders)
+  // Additions to the fixed API: the spec the scene was rendered from, and
+  // per view the index (into spec.objects) of the object seen at each pixel
+  // centre (CV_32S, -1 = background).
+  SyntheticSpec spec;
+  std::vector<cv::Mat> object_id;
 
   // A loader for ImageCache serving `images`.
   ImageCache::Loader Loader() const;
   // Points sampled on the visible surfaces (union over views of the
-  // ground-truth depth maps, one point per `stride` pixels) with normals.
+  // ground-truth depth maps, one point per `stride` pixels) with world-frame
+  // normals and sRGB colours; one-view occluders are excluded.
   PointCloud GroundTruthCloud(int stride = 2) const;
 };
 
@@ -89,7 +102,8 @@ SyntheticScene Render(const SyntheticSpec& spec);
 // `n` cameras on a circle of `radius` at `height` around the origin, looking
 // at the origin (an object ring like Middlebury's).
 std::vector<Eigen::Vector3d> MakeRingCameras(int n, double radius,
-                                             double height, double arc_deg = 360);
+                                             double height,
+                                             double arc_deg = 360);
 // Presets used by many tests.
 // A textured plane at depth ~2 slanted by `slant_deg` about the vertical
 // axis, seen by `n` cameras on a short arc in front of it.
