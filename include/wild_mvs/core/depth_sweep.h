@@ -1,0 +1,34 @@
+// Copyright wild_mvs authors. Coarse fronto-parallel plane sweep: seeds for a
+// reference view without usable sparse features (a fallback the paper does
+// not need, since it always has SfM features).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "wild_mvs/core/mpgc.h"
+#include "wild_mvs/core/region_growing.h"
+#include "wild_mvs/core/thread_pool.h"
+
+namespace wild_mvs {
+
+struct DepthSweepOptions {
+  int step = 8;            // (choice) test every step-th pixel on a grid
+  int num_depths = 64;     // (choice) depths, uniform in 1/z over the range
+  int num_views = 2;       // (choice) score = mean of the best k NCCs
+  double min_score = 0.6;  // (choice) seed only above this mean NCC
+  void Check() const;
+};
+
+// Seeds from the sweep over [min_depth, max_depth] (z in R). Deterministic;
+// parallel over grid rows when pool is given. *pool_cpu_seconds += the CPU
+// time spent on pool threads (RunParallel).
+std::vector<Seed> SweepSeeds(const PatchContext& context,
+                             const MpgcOptions& mpgc,
+                             const LocalViewSelectionOptions& local,
+                             const DepthSweepOptions& options, double min_depth,
+                             double max_depth, const cv::Mat& mask,
+                             ThreadPool* pool,
+                             double* pool_cpu_seconds = nullptr);
+
+}  // namespace wild_mvs

@@ -1,0 +1,61 @@
+// Copyright wild_mvs authors. Global view selection (paper section 5.1 /
+// ALGORITHM.md section 1): the image-level neighbourhood N of a reference
+// view R, chosen from the structure-from-motion features both views share.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "wild_mvs/core/scene.h"
+
+namespace wild_mvs {
+
+struct GlobalViewSelectionOptions {
+  int num_neighbors = 10;        // |N| (paper: 10)
+  double max_parallax_deg = 10;  // a_max of the parallax weight (paper: 10)
+  // (choice, not in the paper) A candidate whose median triangulation angle
+  // with R over the shared features (or at the scene, for the fallback) is
+  // below this never enters N: views taken from the same position (twins)
+  // add no depth information and poison the active set.
+  double min_baseline_deg = 2.5;
+  // (choice) Fallback when R shares no feature with any view: at most this
+  // triangulation angle for a frustum-overlap neighbour.
+  double fallback_max_baseline_deg = 45;
+  void Check() const;
+};
+
+struct GlobalViewSelection {
+  std::vector<int> neighbors;          // scene view indices, in selection order
+  std::vector<double> scores;          // g_R(V) when V was selected (> 0)
+  std::vector<std::string> fallbacks;  // "fallback: ..." notes
+};
+
+// Diameter of the sphere at X whose projection in `cam` is one pixel (the
+// paper's s_X(f) = depth / focal).
+double FeatureScale(const Camera& cam, const Eigen::Vector3d& X);
+
+// The paper's greedy selection by shared-feature score g_R(V) with parallax
+// weight w_N and resolution weight w_s. points_per_view is
+// scene.PointsPerView(). Falls back to SelectViewsByFrustumOverlap (noted in
+// `fallbacks`) when no candidate scores above zero.
+GlobalViewSelection SelectGlobalViews(
+    const Scene& scene, int ref,
+    const std::vector<std::vector<int>>& points_per_view,
+    const GlobalViewSelectionOptions& options);
+
+// Fallback without shared features: neighbours scored by the overlap of
+// their frustum with R's at `scene_depth` (z in R), the parallax weight of
+// their baseline at that depth and the resolution weight.
+GlobalViewSelection SelectViewsByFrustumOverlap(
+    const Scene& scene, int ref, double scene_depth,
+    const GlobalViewSelectionOptions& options);
+
+// A typical scene depth (z in R) for R: the median depth of the sparse points
+// R sees; else of all sparse points inside R's frustum; else where the
+// optical axes of R and the other views pass closest. Returns 0 when none
+// of these exists.
+double EstimateSceneDepth(const Scene& scene, int ref,
+                          const std::vector<std::vector<int>>& points_per_view,
+                          double* min_depth, double* max_depth);
+
+}  // namespace wild_mvs

@@ -1,0 +1,109 @@
+// Copyright wild_mvs authors. MPGC stereo matching of one pixel (paper
+// section 6.2 / ALGORITHM.md section 4): depth along the ray plus the two
+// per-pixel depth offsets (the normal) and one colour scale per active view
+// and channel, by linearised least squares; NCC for confidence and
+// convergence; the paper's schedule. Local view selection (section 3) runs
+// inside, since views are dropped and refilled during the iteration.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "wild_mvs/core/local_view_selection.h"
+#include "wild_mvs/core/patch.h"
+
+namespace wild_mvs {
+
+struct MpgcOptions {
+  int window = 5;                  // n of the n x n window (paper: 5)
+  int settle_iterations = 5;       // iterations before any test (paper: 5)
+  double drop_ncc = 0.4;           // kappa: drop views below (paper: 0.4)
+  double convergence_eps = 1e-3;   // eps on every NCC change (paper: 0.001)
+  int max_iterations = 20;         // fail after (paper: 20)
+  int full_update_interval = 5;    // normal + colour scales every k-th
+                                   // iteration or on an active-set change
+                                   // (paper: 5)
+  int oscillation_iteration = 14;  // from then on drop views whose NCC
+                                   // changed by more than eps (paper: 14)
+  double min_facing = 0.1;         // normal . (-ray) must exceed (paper: 0.1)
+  // (choice: the paper says "the required number of views") Fail when
+  // fewer active views remain.
+  int min_active_views = 3;
+  bool optimize_normal = true;       // false = fronto-parallel (ablation)
+  bool optimize_color_scale = true;  // false = scales fixed to 1 (lab data)
+  void Check() const;
+};
+
+struct PatchResult {
+  double depth = 0;                  // z of the pixel centre
+  Eigen::Vector3d normal{0, 0, -1};  // camera frame, facing the camera
+  double confidence = 0;             // mean NCC over A mapped to [0, 1]
+  int iterations = 0;
+  int num_active = 0;
+  int active[kMaxActive] = {};  // indices into PatchContext::views
+  double ncc[kMaxActive] = {};
+  float color_scale[kMaxActive][3] = {};  // I_R = c * I_V per channel
+};
+
+// Matches pixels of one reference view. Not thread-safe (it owns its
+// scratch space): use one per thread. Allocation-free per call.
+class PatchMatcher {
+ public:
+  PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
+               const LocalViewSelectionOptions& local);
+
+  // Local view selection + MPGC at pixel (s, t) (integer column and row;
+  // centre (s + .5, t + .5)) from depth z and camera-frame normal `normal`.
+  // True on success (converged, facing, enough views); fills *out.
+  bool Match(int s, int t, double depth, const Eigen::Vector3d& normal,
+             PatchResult* out);
+
+  // Mean of the best `k` NCC scores over N of the window at pixel (s, t) on
+  // the plane (depth, normal), without optimisation (for the depth sweep).
+  // Returns -1 when fewer than k views see the window.
+  double PlaneScore(int s, int t, double depth, const Eigen::Vector3d& normal,
+                    int k);
+
+  // Whether the window around (s, t) lies inside R's image.
+  bool WindowInside(int s, int t) const;
+
+ private:
+  bool SetupPixel(int s, int t, double depth, const Eigen::Vector3d& normal);
+  bool PrepareView(int v, int slot_index);
+  bool SampleSlot(int slot_index, bool with_gradient);
+  double SlotNcc(int slot_index) const;
+  void InitScales(int slot_index);
+  int FreeSlot() const;
+  int FillActive();
+  void RemoveActive(int a);
+
+  const PatchContext& ctx_;
+  MpgcOptions mpgc_;
+  LocalViewSelectionOptions local_;
+  int n_ = 5, half_ = 2, npix_ = 25, channels_ = 3;
+  double max_angle_rad_ = 0;
+  // Current pixel and window surface (h along the ray, per-pixel offsets).
+  int s_ = 0, t_ = 0;
+  double h_ = 0, hs_ = 0, ht_ = 0;
+  double inv_norm_[kMaxWindowPixels];  // 1 / |K^-1 (u, v, 1)|
+  float ref_[3 * kMaxWindowPixels];    // planar: channel c at c * npix
+  double ref_sum_[3];
+  // Candidate state this visit: 0 free, 1 active, 2 rejected.
+  uint8_t state_[kMaxNeighbors];
+  Eigen::Vector2d epi_dir_[kMaxNeighbors];
+  double global_scores_[kMaxNeighbors];
+  int active_[kMaxActive];       // view indices of A
+  int active_slot_[kMaxActive];  // their scratch slots
+  int num_active_ = 0;
+  struct SlotData {
+    int view = -1;
+    double a[kMaxWindowPixels][3];     // A_V (u, v, 1) / |K^-1 (u, v, 1)|
+    float val[3 * kMaxWindowPixels];   // planar samples
+    float dval[3 * kMaxWindowPixels];  // d sample / d h (along the ray)
+    float scale[3];
+    double ncc, prev_ncc;
+  };
+  SlotData slots_[kMaxActive + 1];
+};
+
+}  // namespace wild_mvs

@@ -1,0 +1,59 @@
+// Copyright wild_mvs authors. The per-view MVS driver: global view
+// selection, rescaling, seeding, region growing with MPGC matching, for one
+// reference view (Goesele et al. 2007; ALGORITHM.md sections 1-5).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "wild_mvs/core/depth_map.h"
+#include "wild_mvs/core/depth_sweep.h"
+#include "wild_mvs/core/global_view_selection.h"
+#include "wild_mvs/core/image.h"
+#include "wild_mvs/core/local_view_selection.h"
+#include "wild_mvs/core/mpgc.h"
+#include "wild_mvs/core/region_growing.h"
+#include "wild_mvs/core/rescaling.h"
+#include "wild_mvs/core/scene.h"
+#include "wild_mvs/core/thread_pool.h"
+
+namespace wild_mvs {
+
+struct MvsOptions {
+  GlobalViewSelectionOptions global;
+  RescalingOptions rescaling;
+  LocalViewSelectionOptions local;
+  MpgcOptions mpgc;
+  RegionGrowingOptions growing;
+  DepthSweepOptions sweep;  // fallback seeding without sparse features
+  bool use_color = true;    // false = match grey images (ablation)
+  int max_image_size = 0;   // longest side of R's working image; 0 = any
+  void Check() const;
+};
+
+struct ViewReport {
+  std::vector<int> neighbors;           // scene view indices (N)
+  std::vector<double> neighbor_scores;  // g_R(V)
+  std::vector<double> scales;           // scale_R(V) before rescaling
+  double working_scale = 1;             // working / original size of R
+  int width = 0, height = 0;            // working resolution
+  int seeds_tried = 0, seeds_accepted = 0;
+  int samples = 0;                     // valid depth samples in the result
+  long long pixel_visits = 0;          // MPGC runs
+  std::vector<std::string> fallbacks;  // "fallback: ..." notes
+  double seconds = 0, cpu_seconds = 0;
+  // One JSON object (neighbours by name).
+  std::string ToJson(const Scene& scene) const;
+};
+
+// Reconstructs the depth map of view `ref`. images serves full-resolution
+// images (resized copies come from it). pool may be null (inline) and must
+// not be the pool this call runs on (ThreadPool::ParallelFor). mask: CV_8U of
+// the reference image's size, 0 = ignore (empty = none). Deterministic: the
+// same output whatever the number of threads. Throws Error on bad input.
+DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
+                         const MvsOptions& options, ThreadPool* pool,
+                         ViewReport* report, const cv::Mat& mask = cv::Mat());
+
+}  // namespace wild_mvs

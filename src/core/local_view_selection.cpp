@@ -1,0 +1,56 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/core/local_view_selection.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "wild_mvs/core/error.h"
+
+namespace wild_mvs {
+
+void LocalViewSelectionOptions::Check() const {
+  Require(num_active >= 1 && num_active <= 8, "local.num_active = ", num_active,
+          " must be in [1, 8]");
+  Require(max_epipolar_angle_deg > 0 && max_epipolar_angle_deg <= 90,
+          "local.max_epipolar_angle_deg = ", max_epipolar_angle_deg,
+          " must be in (0, 90]");
+  Require(min_ncc >= -1 && min_ncc <= 1, "local.min_ncc = ", min_ncc,
+          " must be in [-1, 1]");
+}
+
+Eigen::Vector2d EpipolarDirection(const Eigen::Vector3d& e, double x,
+                                  double y) {
+  // Line through (x, y, 1) and e: l = x cross e; its direction is (l1, -l0).
+  const Eigen::Vector3d l = Eigen::Vector3d(x, y, 1.0).cross(e);
+  Eigen::Vector2d d(l.y(), -l.x());
+  const double n = d.norm();
+  if (n < 1e-12) return Eigen::Vector2d(1, 0);
+  return d / n;
+}
+
+double EpipolarWeight(const Eigen::Vector2d& d1, const Eigen::Vector2d& d2,
+                      double max_angle_rad) {
+  const double c = std::min(1.0, std::abs(d1.dot(d2)));
+  const double g = std::acos(c);  // acute angle in [0, pi/2]
+  return std::min(g / max_angle_rad, 1.0);
+}
+
+int PickNextView(int num_views, const double* global_scores,
+                 const Eigen::Vector2d* directions, const uint8_t* state,
+                 const int* active, int num_active, double max_angle_rad) {
+  int best = -1;
+  double best_score = -1;
+  for (int v = 0; v < num_views; ++v) {
+    if (state[v] != 0) continue;
+    double l = global_scores[v];
+    for (int a = 0; a < num_active && l > best_score; ++a)
+      l *= EpipolarWeight(directions[v], directions[active[a]], max_angle_rad);
+    if (l > best_score) {
+      best_score = l;
+      best = v;
+    }
+  }
+  return best;
+}
+
+}  // namespace wild_mvs

@@ -1,0 +1,468 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/core/mpgc.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/ncc.h"
+
+namespace wild_mvs {
+
+void MpgcOptions::Check() const {
+  Require(window >= 3 && window <= kMaxWindow && window % 2 == 1,
+          "mpgc.window = ", window, " must be odd and in [3, ", kMaxWindow,
+          "]");
+  Require(settle_iterations >= 0,
+          "mpgc.settle_iterations = ", settle_iterations, " must be >= 0");
+  Require(drop_ncc >= -1 && drop_ncc <= 1, "mpgc.drop_ncc = ", drop_ncc,
+          " must be in [-1, 1]");
+  Require(convergence_eps > 0, "mpgc.convergence_eps = ", convergence_eps,
+          " must be > 0");
+  Require(max_iterations > settle_iterations,
+          "mpgc.max_iterations = ", max_iterations,
+          " must exceed mpgc.settle_iterations = ", settle_iterations);
+  Require(full_update_interval >= 1,
+          "mpgc.full_update_interval = ", full_update_interval,
+          " must be >= 1");
+  Require(oscillation_iteration >= 0,
+          "mpgc.oscillation_iteration = ", oscillation_iteration,
+          " must be >= 0");
+  Require(min_facing >= 0 && min_facing < 1, "mpgc.min_facing = ", min_facing,
+          " must be in [0, 1)");
+  Require(min_active_views >= 1 && min_active_views <= kMaxActive,
+          "mpgc.min_active_views = ", min_active_views, " must be in [1, ",
+          kMaxActive, "]");
+}
+
+PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
+                           const LocalViewSelectionOptions& local)
+    : ctx_(context), mpgc_(mpgc), local_(local) {
+  mpgc_.Check();
+  local_.Check();
+  Require(mpgc_.window == ctx_.window, "PatchMatcher: window ", mpgc_.window,
+          " differs from the context's ", ctx_.window);
+  Require(mpgc_.min_active_views <= local_.num_active,
+          "mpgc.min_active_views = ", mpgc_.min_active_views,
+          " must not exceed local.num_active = ", local_.num_active);
+  n_ = mpgc_.window;
+  half_ = n_ / 2;
+  npix_ = n_ * n_;
+  channels_ = ctx_.ref_image.channels;
+  Require(channels_ == 1 || channels_ == 3, "PatchMatcher: ", channels_,
+          " channels (1 or 3 expected)");
+  for (const PatchView& v : ctx_.views)
+    Require(v.image.channels == channels_,
+            "PatchMatcher: neighbour images must have the reference's ",
+            channels_, " channels");
+  Require(ctx_.views.size() <= static_cast<size_t>(kMaxNeighbors),
+          "PatchMatcher: too many neighbours");
+  max_angle_rad_ = local_.max_epipolar_angle_deg * M_PI / 180.0;
+  for (size_t v = 0; v < ctx_.views.size(); ++v)
+    global_scores_[v] = ctx_.views[v].global_score;
+}
+
+bool PatchMatcher::WindowInside(int s, int t) const {
+  return s - half_ >= 0 && t - half_ >= 0 && s + half_ < ctx_.ref_image.width &&
+         t + half_ < ctx_.ref_image.height;
+}
+
+// Precomputes the window's rays mapped into view v.
+bool PatchMatcher::PrepareView(int v, int slot_index) {
+  SlotData& sl = slots_[slot_index];
+  sl.view = v;
+  const Eigen::Matrix3d& A = ctx_.views[v].A;
+  const double u0 = s_ + 0.5 - half_, v0 = t_ + 0.5 - half_;
+  const Eigen::Vector3d base = A * Eigen::Vector3d(u0, v0, 1.0);
+  const Eigen::Vector3d cu = A.col(0), cv = A.col(1);
+  int idx = 0;
+  for (int j = 0; j < n_; ++j) {
+    const Eigen::Vector3d row = base + j * cv;
+    for (int i = 0; i < n_; ++i, ++idx) {
+      const double w = inv_norm_[idx];
+      sl.a[idx][0] = (row.x() + i * cu.x()) * w;
+      sl.a[idx][1] = (row.y() + i * cu.y()) * w;
+      sl.a[idx][2] = (row.z() + i * cu.z()) * w;
+    }
+  }
+  return true;
+}
+
+// Samples view slot at the current (h, hs, ht); false when any window pixel
+// falls outside the image or behind the camera.
+bool PatchMatcher::SampleSlot(int slot_index, bool with_gradient) {
+  SlotData& sl = slots_[slot_index];
+  const PatchView& pv = ctx_.views[sl.view];
+  const MatchImage& im = pv.image;
+  const double b0 = pv.b.x(), b1 = pv.b.y(), b2 = pv.b.z();
+  float val[3], gx[3], gy[3];
+  int idx = 0;
+  for (int j = -half_; j <= half_; ++j) {
+    const double hrow = h_ + j * ht_;
+    for (int i = -half_; i <= half_; ++i, ++idx) {
+      const double hh = hrow + i * hs_;
+      const double* a = sl.a[idx];
+      const double q2 = b2 + hh * a[2];
+      if (!(q2 > 1e-12)) return false;
+      const double inv = 1.0 / q2;
+      const double x = (b0 + hh * a[0]) * inv;
+      const double y = (b1 + hh * a[1]) * inv;
+      if (!InSampleRange(im, x, y)) return false;
+      if (with_gradient) {
+        SampleBilinear(im, x, y, val, gx, gy, 1);
+        const float dx = static_cast<float>((a[0] - x * a[2]) * inv);
+        const float dy = static_cast<float>((a[1] - y * a[2]) * inv);
+        for (int c = 0; c < channels_; ++c) {
+          sl.val[c * npix_ + idx] = val[c];
+          sl.dval[c * npix_ + idx] = gx[c] * dx + gy[c] * dy;
+        }
+      } else {
+        SampleBilinear(im, x, y, val, nullptr, nullptr, 1);
+        for (int c = 0; c < channels_; ++c) sl.val[c * npix_ + idx] = val[c];
+      }
+    }
+  }
+  return true;
+}
+
+double PatchMatcher::SlotNcc(int slot_index) const {
+  return NccChannels(ref_, slots_[slot_index].val, npix_, channels_, npix_);
+}
+
+void PatchMatcher::InitScales(int slot_index) {
+  SlotData& sl = slots_[slot_index];
+  for (int c = 0; c < 3; ++c) sl.scale[c] = 1.0f;
+  if (!mpgc_.optimize_color_scale) return;
+  for (int c = 0; c < channels_; ++c) {
+    double sv = 0;
+    const float* p = sl.val + c * npix_;
+    for (int i = 0; i < npix_; ++i) sv += p[i];
+    if (sv > 1e-6 && ref_sum_[c] > 1e-6)
+      sl.scale[c] = static_cast<float>(ref_sum_[c] / sv);
+  }
+}
+
+int PatchMatcher::FreeSlot() const {
+  bool used[kMaxActive + 1] = {};
+  for (int a = 0; a < num_active_; ++a) used[active_slot_[a]] = true;
+  for (int s = 0; s <= kMaxActive; ++s)
+    if (!used[s]) return s;
+  return -1;  // unreachable: at most kMaxActive are active
+}
+
+// Local view selection: fills A up to m views. Entering views are sampled
+// (values only) and get their NCC and initial colour scales. Returns the
+// number of views that entered.
+int PatchMatcher::FillActive() {
+  int entered = 0;
+  const int nv = static_cast<int>(ctx_.views.size());
+  while (num_active_ < local_.num_active) {
+    const int v = PickNextView(nv, global_scores_, epi_dir_, state_, active_,
+                               num_active_, max_angle_rad_);
+    if (v < 0) break;
+    const int slot = FreeSlot();
+    PrepareView(v, slot);
+    if (!SampleSlot(slot, false)) {
+      state_[v] = 2;
+      continue;
+    }
+    const double ncc = SlotNcc(slot);
+    if (local_.enabled && ncc < local_.min_ncc) {
+      state_[v] = 2;
+      continue;
+    }
+    SlotData& sl = slots_[slot];
+    sl.ncc = ncc;
+    sl.prev_ncc = std::numeric_limits<double>::quiet_NaN();
+    InitScales(slot);
+    state_[v] = 1;
+    active_[num_active_] = v;
+    active_slot_[num_active_] = slot;
+    ++num_active_;
+    ++entered;
+  }
+  return entered;
+}
+
+void PatchMatcher::RemoveActive(int a) {
+  state_[active_[a]] = 2;
+  for (int k = a + 1; k < num_active_; ++k) {
+    active_[k - 1] = active_[k];
+    active_slot_[k - 1] = active_slot_[k];
+  }
+  --num_active_;
+}
+
+bool PatchMatcher::SetupPixel(int s, int t, double depth,
+                              const Eigen::Vector3d& normal) {
+  if (!WindowInside(s, t) || !(depth > 0) || !std::isfinite(depth))
+    return false;
+  s_ = s;
+  t_ = t;
+  const Camera& cam = ctx_.ref_camera;
+  const MatchImage& ri = ctx_.ref_image;
+  int idx = 0;
+  for (int c = 0; c < 3; ++c) ref_sum_[c] = 0;
+  double var_total = 0;
+  for (int j = -half_; j <= half_; ++j) {
+    const float* row =
+        ri.data +
+        (static_cast<size_t>(t + j) * ri.width + (s - half_)) * channels_;
+    const double y = (t + j + 0.5 - cam.cy) / cam.fy;
+    for (int i = 0; i < n_; ++i, ++idx) {
+      const double x = (s - half_ + i + 0.5 - cam.cx) / cam.fx;
+      inv_norm_[idx] = 1.0 / std::sqrt(x * x + y * y + 1.0);
+      for (int c = 0; c < channels_; ++c) {
+        ref_[c * npix_ + idx] = row[i * channels_ + c];
+        ref_sum_[c] += row[i * channels_ + c];
+      }
+    }
+  }
+  for (int c = 0; c < channels_; ++c) {
+    const double mean = ref_sum_[c] / npix_;
+    for (int i = 0; i < npix_; ++i) {
+      const double d = ref_[c * npix_ + i] - mean;
+      var_total += d * d;
+    }
+  }
+  // A textureless reference window cannot be matched (NCC undefined).
+  if (var_total < kNccMinVariance * npix_ * channels_ * 100) return false;
+  Eigen::Vector3d n = normal;
+  if (!mpgc_.optimize_normal || !(n.norm() > 0.5))
+    n = Eigen::Vector3d(0, 0, -1);
+  h_ = PlaneToPatch(cam, s, t, depth, n.normalized(), &hs_, &ht_);
+  if (!std::isfinite(h_) || h_ <= 0) return false;
+  const double u = s + 0.5, v = t + 0.5;
+  const int nv = static_cast<int>(ctx_.views.size());
+  for (int k = 0; k < nv; ++k) {
+    epi_dir_[k] = EpipolarDirection(ctx_.views[k].epipole, u, v);
+    state_[k] = (!local_.enabled && k >= local_.num_active) ? 2 : 0;
+  }
+  num_active_ = 0;
+  return true;
+}
+
+double PatchMatcher::PlaneScore(int s, int t, double depth,
+                                const Eigen::Vector3d& normal, int k) {
+  if (!SetupPixel(s, t, depth, normal)) return -1;
+  double best[kMaxNeighbors];
+  int count = 0;
+  const int slot = kMaxActive;
+  for (size_t v = 0; v < ctx_.views.size(); ++v) {
+    PrepareView(static_cast<int>(v), slot);
+    if (!SampleSlot(slot, false)) continue;
+    best[count++] = SlotNcc(slot);
+  }
+  if (count < k || k <= 0) return -1;
+  std::partial_sort(best, best + k, best + count, std::greater<double>());
+  double sum = 0;
+  for (int i = 0; i < k; ++i) sum += best[i];
+  return sum / k;
+}
+
+bool PatchMatcher::Match(int s, int t, double depth,
+                         const Eigen::Vector3d& normal, PatchResult* out) {
+  if (!SetupPixel(s, t, depth, normal)) return false;
+  FillActive();
+  if (num_active_ < mpgc_.min_active_views) return false;
+
+  const bool fit_normal = mpgc_.optimize_normal;
+  const bool fit_scale = mpgc_.optimize_color_scale;
+  bool changed = true;  // a new active set: full update first
+  bool converged = false;
+  int it = 0;
+  for (; it < mpgc_.max_iterations; ++it) {
+    // Sample the active views (values + derivatives) at the current patch.
+    for (int a = 0; a < num_active_;) {
+      if (!SampleSlot(active_slot_[a], true)) {
+        RemoveActive(a);
+        changed = true;
+      } else {
+        ++a;
+      }
+    }
+    if (it >= mpgc_.settle_iterations) {
+      bool dropped = false, stable = true;
+      for (int a = 0; a < num_active_;) {
+        SlotData& sl = slots_[active_slot_[a]];
+        sl.prev_ncc = sl.ncc;
+        sl.ncc = SlotNcc(active_slot_[a]);
+        const double change = std::abs(sl.ncc - sl.prev_ncc);
+        const bool moved = !(change <= mpgc_.convergence_eps);
+        if (moved) stable = false;
+        if (sl.ncc < mpgc_.drop_ncc ||
+            (it >= mpgc_.oscillation_iteration && moved)) {
+          RemoveActive(a);
+          dropped = true;
+        } else {
+          ++a;
+        }
+      }
+      if (!dropped && stable && !changed &&
+          num_active_ >= mpgc_.min_active_views) {
+        converged = true;
+        break;
+      }
+      if (dropped) {
+        changed = true;
+        if (local_.enabled) {
+          const int first_new = num_active_;
+          FillActive();
+          for (int a = first_new; a < num_active_;) {
+            if (!SampleSlot(active_slot_[a], true)) {
+              RemoveActive(a);
+            } else {
+              ++a;
+            }
+          }
+        }
+      }
+    } else if (changed && num_active_ < local_.num_active && local_.enabled) {
+      // A view left the image during settling: refill.
+      const int first_new = num_active_;
+      FillActive();
+      for (int a = first_new; a < num_active_;) {
+        if (!SampleSlot(active_slot_[a], true)) {
+          RemoveActive(a);
+        } else {
+          ++a;
+        }
+      }
+    }
+    if (num_active_ < mpgc_.min_active_views) return false;
+
+    // Linearised least squares. Residual e = I_R - c * I_V; unknowns
+    // d = (dh, dhs, dht) and dc per (view, channel); the colour scales are
+    // eliminated by the Schur complement, leaving a 3x3 (or 1x1) system.
+    const bool full = changed || (it % mpgc_.full_update_interval == 0);
+    const bool geo3 = full && fit_normal;
+    const bool scales = full && fit_scale;
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    double sii[kMaxActive][3], sie[kMaxActive][3];
+    Eigen::Vector3d sij[kMaxActive][3];
+    for (int a = 0; a < num_active_; ++a) {
+      const SlotData& sl = slots_[active_slot_[a]];
+      for (int c = 0; c < channels_; ++c) {
+        const float* val = sl.val + c * npix_;
+        const float* dv = sl.dval + c * npix_;
+        const float* rv = ref_ + c * npix_;
+        const double sc = sl.scale[c];
+        double q2 = 0, q2i = 0, q2j = 0, q2ii = 0, q2ij = 0, q2jj = 0;
+        double qe = 0, qei = 0, qej = 0, ii = 0, ie = 0, iq = 0, iqi = 0,
+               iqj = 0;
+        int idx = 0;
+        for (int j = -half_; j <= half_; ++j) {
+          double r_q2 = 0, r_q2i = 0, r_q2ii = 0, r_qe = 0, r_qei = 0, r_iq = 0,
+                 r_iqi = 0;
+          for (int i = -half_; i <= half_; ++i, ++idx) {
+            const double I = val[idx];
+            const double q = sc * dv[idx];
+            const double e = rv[idx] - sc * I;
+            const double qq = q * q;
+            r_q2 += qq;
+            r_q2i += qq * i;
+            r_q2ii += qq * i * i;
+            r_qe += q * e;
+            r_qei += q * e * i;
+            r_iq += I * q;
+            r_iqi += I * q * i;
+            ii += I * I;
+            ie += I * e;
+          }
+          q2 += r_q2;
+          q2i += r_q2i;
+          q2j += r_q2 * j;
+          q2ii += r_q2ii;
+          q2ij += r_q2i * j;
+          q2jj += r_q2 * j * j;
+          qe += r_qe;
+          qei += r_qei;
+          qej += r_qe * j;
+          iq += r_iq;
+          iqi += r_iqi;
+          iqj += r_iq * j;
+        }
+        H(0, 0) += q2;
+        H(0, 1) += q2i;
+        H(0, 2) += q2j;
+        H(1, 1) += q2ii;
+        H(1, 2) += q2ij;
+        H(2, 2) += q2jj;
+        g += Eigen::Vector3d(qe, qei, qej);
+        sii[a][c] = ii;
+        sie[a][c] = ie;
+        sij[a][c] = Eigen::Vector3d(iq, iqi, iqj);
+      }
+    }
+    H(1, 0) = H(0, 1);
+    H(2, 0) = H(0, 2);
+    H(2, 1) = H(1, 2);
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    if (scales) {
+      for (int a = 0; a < num_active_; ++a)
+        for (int c = 0; c < channels_; ++c) {
+          if (!(sii[a][c] > 1e-12)) continue;
+          H -= sij[a][c] * sij[a][c].transpose() / sii[a][c];
+          g -= sij[a][c] * (sie[a][c] / sii[a][c]);
+        }
+    }
+    if (geo3) {
+      Eigen::Matrix3d Hd = H;
+      const double damp = 1e-9 * (H.trace() + 1e-30);
+      Hd.diagonal().array() += damp;
+      Eigen::LDLT<Eigen::Matrix3d> ldlt(Hd);
+      if (ldlt.info() != Eigen::Success) return false;
+      d = ldlt.solve(g);
+    } else {
+      if (!(H(0, 0) > 1e-20)) return false;
+      d.x() = g.x() / H(0, 0);
+    }
+    if (!d.allFinite()) return false;
+    if (scales) {
+      for (int a = 0; a < num_active_; ++a) {
+        SlotData& sl = slots_[active_slot_[a]];
+        for (int c = 0; c < channels_; ++c) {
+          if (!(sii[a][c] > 1e-12)) continue;
+          const double dc = (sie[a][c] - sij[a][c].dot(d)) / sii[a][c];
+          const double nc = sl.scale[c] + dc;
+          if (nc > 1e-3 && nc < 1e3) sl.scale[c] = static_cast<float>(nc);
+        }
+      }
+    }
+    h_ += d.x();
+    if (geo3) {
+      hs_ += d.y();
+      ht_ += d.z();
+    }
+    if (!(h_ > 0) || !std::isfinite(h_)) return false;
+    changed = false;
+  }
+  if (!converged) return false;
+
+  const Camera& cam = ctx_.ref_camera;
+  const Eigen::Vector3d ray = RayAt(cam, s + 0.5, t + 0.5);
+  const Eigen::Vector3d n = PatchNormal(cam, s, t, h_, hs_, ht_);
+  if (!(n.dot(-ray) > mpgc_.min_facing)) return false;
+  double sum = 0;
+  for (int a = 0; a < num_active_; ++a) sum += slots_[active_slot_[a]].ncc;
+  if (out) {
+    out->depth = h_ * ray.z();
+    out->normal = mpgc_.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);
+    out->confidence = std::clamp((sum / num_active_ + 1.0) * 0.5, 0.0, 1.0);
+    out->iterations = it + 1;
+    out->num_active = num_active_;
+    for (int a = 0; a < num_active_; ++a) {
+      const SlotData& sl = slots_[active_slot_[a]];
+      out->active[a] = active_[a];
+      out->ncc[a] = sl.ncc;
+      for (int c = 0; c < 3; ++c)
+        out->color_scale[a][c] = sl.scale[channels_ == 1 ? 0 : c];
+    }
+  }
+  return true;
+}
+
+}  // namespace wild_mvs

@@ -1,0 +1,278 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/core/reconstruct_view.h"
+
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <unordered_set>
+
+#include "wild_mvs/core/error.h"
+
+namespace wild_mvs {
+
+void MvsOptions::Check() const {
+  global.Check();
+  rescaling.Check();
+  local.Check();
+  mpgc.Check();
+  growing.Check();
+  sweep.Check();
+  Require(max_image_size >= 0, "mvs.max_image_size = ", max_image_size,
+          " must be >= 0 (0 = no limit)");
+  Require(mpgc.min_active_views <= local.num_active,
+          "mpgc.min_active_views = ", mpgc.min_active_views,
+          " must not exceed local.num_active = ", local.num_active);
+}
+
+namespace {
+
+std::string JsonEscape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '"':
+        o += "\\\"";
+        break;
+      case '\\':
+        o += "\\\\";
+        break;
+      case '\n':
+        o += "\\n";
+        break;
+      case '\t':
+        o += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          snprintf(buf, sizeof(buf), "\\u%04x", c);
+          o += buf;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o;
+}
+
+std::string JsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+// A matching copy of an image: contiguous interleaved float, RGB or grey.
+struct OwnedImage {
+  std::shared_ptr<const cv::Mat> rgb;  // keeps the cache entry alive
+  std::vector<float> grey;
+  MatchImage view;
+};
+
+OwnedImage MakeMatchImage(std::shared_ptr<const cv::Mat> img, bool color) {
+  Require(img && !img->empty() && img->type() == CV_32FC3,
+          "ReconstructView: images must be CV_32FC3 (ImageCache)");
+  OwnedImage o;
+  o.view.width = img->cols;
+  o.view.height = img->rows;
+  if (color) {
+    if (!img->isContinuous())
+      img = std::make_shared<const cv::Mat>(img->clone());
+    o.rgb = img;
+    o.view.data = o.rgb->ptr<float>();
+    o.view.channels = 3;
+  } else {
+    o.grey.resize(static_cast<size_t>(img->cols) * img->rows);
+    for (int r = 0; r < img->rows; ++r) {
+      const float* p = img->ptr<float>(r);
+      float* g = o.grey.data() + static_cast<size_t>(r) * img->cols;
+      for (int c = 0; c < img->cols; ++c)
+        g[c] = (p[3 * c] + p[3 * c + 1] + p[3 * c + 2]) * (1.0f / 3.0f);
+    }
+    o.view.data = o.grey.data();
+    o.view.channels = 1;
+  }
+  return o;
+}
+
+}  // namespace
+
+std::string ViewReport::ToJson(const Scene& scene) const {
+  std::ostringstream os;
+  auto name = [&](int v) {
+    return (v >= 0 && v < static_cast<int>(scene.views.size()))
+               ? scene.views[v].name
+               : std::string("?");
+  };
+  os << "{\n  \"neighbors\": [";
+  for (size_t i = 0; i < neighbors.size(); ++i) {
+    os << (i ? ", " : "") << "{\"view\": \"" << JsonEscape(name(neighbors[i]))
+       << "\", \"score\": "
+       << JsonNumber(i < neighbor_scores.size() ? neighbor_scores[i] : 0)
+       << ", \"scale\": " << JsonNumber(i < scales.size() ? scales[i] : 0)
+       << "}";
+  }
+  os << "],\n  \"working_scale\": " << JsonNumber(working_scale)
+     << ",\n  \"width\": " << width << ",\n  \"height\": " << height
+     << ",\n  \"seeds_tried\": " << seeds_tried
+     << ",\n  \"seeds_accepted\": " << seeds_accepted
+     << ",\n  \"samples\": " << samples
+     << ",\n  \"pixel_visits\": " << pixel_visits << ",\n  \"fallbacks\": [";
+  for (size_t i = 0; i < fallbacks.size(); ++i)
+    os << (i ? ", " : "") << "\"" << JsonEscape(fallbacks[i]) << "\"";
+  os << "],\n  \"seconds\": " << JsonNumber(seconds)
+     << ",\n  \"cpu_seconds\": " << JsonNumber(cpu_seconds) << "\n}\n";
+  return os.str();
+}
+
+DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
+                         const MvsOptions& options, ThreadPool* pool,
+                         ViewReport* report, const cv::Mat& mask) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const double cpu0 = ThreadCpuSeconds();
+  double body_cpu = 0;
+  options.Check();
+  Require(ref >= 0 && ref < static_cast<int>(scene.views.size()),
+          "ReconstructView: no view ", ref, " (the scene has ",
+          scene.views.size(), ")");
+  const Camera& cam_full = scene.views[ref].camera;
+  cam_full.Validate("view '" + scene.views[ref].name + "'");
+  Require(
+      mask.empty() || (mask.type() == CV_8U && mask.cols == cam_full.width &&
+                       mask.rows == cam_full.height),
+      "ReconstructView: mask of view '", scene.views[ref].name,
+      "' must be CV_8U ", cam_full.width, "x", cam_full.height);
+  ViewReport rep;
+  const std::vector<std::vector<int>> ppv = scene.PointsPerView();
+
+  // 1. Global view selection.
+  GlobalViewSelection sel = SelectGlobalViews(scene, ref, ppv, options.global);
+  rep.fallbacks = sel.fallbacks;
+  rep.neighbors = sel.neighbors;
+  rep.neighbor_scores = sel.scores;
+
+  double dmin = 0, dmax = 0;
+  const double scene_depth = EstimateSceneDepth(scene, ref, ppv, &dmin, &dmax);
+  const Eigen::Vector3d axis_point = cam_full.Backproject(
+      Eigen::Vector2d(cam_full.width * 0.5, cam_full.height * 0.5),
+      scene_depth > 0 ? scene_depth : 1.0);
+
+  // 2. Rescaling.
+  for (int v : sel.neighbors)
+    rep.scales.push_back(ScaleRatio(scene, ref, v, ppv, &axis_point));
+  const RescalingPlan plan =
+      PlanRescaling(scene, ref, sel.neighbors, rep.scales, options.rescaling,
+                    options.max_image_size);
+  const Camera& cam = plan.ref_camera;
+  rep.working_scale = static_cast<double>(cam.width) / cam_full.width;
+  rep.width = cam.width;
+  rep.height = cam.height;
+
+  DepthMap dm;
+  dm.view = ref;
+  dm.camera = cam;
+  dm.neighbors = sel.neighbors;
+  dm.depth = cv::Mat::zeros(cam.height, cam.width, CV_32F);
+  dm.normal = cv::Mat::zeros(cam.height, cam.width, CV_32FC3);
+  dm.confidence = cv::Mat::zeros(cam.height, cam.width, CV_32F);
+
+  if (sel.neighbors.empty()) {
+    rep.fallbacks.push_back(
+        Msg("fallback: view '", scene.views[ref].name,
+            "' has no usable neighbour (no shared features and no "
+            "overlapping view with parallax); its depth map is empty"));
+  } else {
+    // Images at their working resolutions.
+    const OwnedImage ref_img = MakeMatchImage(
+        images.GetResized(ref, cam.width, cam.height), options.use_color);
+    std::vector<OwnedImage> nb_img;
+    nb_img.reserve(sel.neighbors.size());
+    PatchContext ctx;
+    ctx.ref_camera = cam;
+    ctx.ref_image = ref_img.view;
+    ctx.window = options.mpgc.window;
+    for (size_t i = 0; i < sel.neighbors.size(); ++i) {
+      const Camera& nc = plan.neighbor_cameras[i];
+      nb_img.push_back(MakeMatchImage(
+          images.GetResized(sel.neighbors[i], nc.width, nc.height),
+          options.use_color));
+      ctx.AddView(sel.neighbors[i], nc, nb_img.back().view,
+                  sel.scores[i] > 0 ? sel.scores[i] : 1e-6);
+    }
+
+    cv::Mat wmask;
+    if (!mask.empty()) {
+      if (mask.cols == cam.width && mask.rows == cam.height)
+        wmask = mask.clone();
+      else
+        cv::resize(mask, wmask, cv::Size(cam.width, cam.height), 0, 0,
+                   cv::INTER_NEAREST);
+    }
+
+    // 3. Seeds: R's features, then the neighbours' features projected in R.
+    std::vector<Seed> seeds;
+    std::unordered_set<int> used;
+    auto add_point = [&](int p) {
+      if (!used.insert(p).second) return;
+      Eigen::Vector2d px;
+      const Eigen::Vector3d& X = scene.points[p].xyz;
+      if (!cam.Project(X, &px) || !cam.InImage(px)) return;
+      const int x = static_cast<int>(std::floor(px.x()));
+      const int y = static_cast<int>(std::floor(px.y()));
+      if (x < 0 || y < 0 || x >= cam.width || y >= cam.height) return;
+      seeds.push_back(Seed{x, y, cam.Depth(X)});
+    };
+    for (int p : ppv[ref]) add_point(p);
+    if (options.growing.seeds_from_neighbors)
+      for (int v : sel.neighbors)
+        for (int p : ppv[v]) add_point(p);
+
+    GrowStats stats;
+    if (!seeds.empty())
+      GrowRegions(ctx, options.mpgc, options.local, options.growing, seeds,
+                  wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats);
+    if (stats.seeds_accepted == 0) {
+      // No sparse feature produced a match: seed from a plane sweep.
+      double lo = dmin, hi = dmax;
+      if (!(lo > 0) || !(hi > lo)) {
+        lo = scene_depth * 0.5;
+        hi = scene_depth * 2.0;
+      }
+      lo *= 0.8;
+      hi *= 1.25;
+      std::vector<Seed> swept;
+      if (scene_depth > 0)
+        swept = SweepSeeds(ctx, options.mpgc, options.local, options.sweep, lo,
+                           hi, wmask, pool, &body_cpu);
+      rep.fallbacks.push_back(
+          Msg("fallback: view '", scene.views[ref].name, "': ",
+              seeds.empty() ? "no sparse feature projects into it"
+                            : "no sparse feature could be matched",
+              "; seeded from a fronto-parallel depth sweep over [", lo, ", ",
+              hi, "]: ", swept.size(), " seeds"));
+      if (!swept.empty())
+        GrowRegions(ctx, options.mpgc, options.local, options.growing, swept,
+                    wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats);
+    }
+    rep.seeds_tried = stats.seeds_tried;
+    rep.seeds_accepted = stats.seeds_accepted;
+    rep.pixel_visits = stats.pixel_visits;
+    body_cpu += stats.cpu_seconds;
+  }
+  rep.samples = dm.CountValid();
+  rep.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0)
+          .count();
+  // CPU: this thread's own time plus the work done on pool threads.
+  const double own = ThreadCpuSeconds() - cpu0;
+  rep.cpu_seconds = body_cpu + own;
+  if (report) *report = rep;
+  return dm;
+}
+
+}  // namespace wild_mvs
