@@ -12,11 +12,11 @@ ROS="catkin ros-message-generation ros-message-runtime \
  ros-std-msgs ros-sensor-msgs ros-geometry-msgs \
  libcv-bridge-dev libimage-transport-dev libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev \
  libpcl-conversions-dev libpcl-ros-dev librosbag-dev librostest-dev \
- libnodelet-dev libmessage-filters-dev libimage-geometry-dev \
+ libnodelet-dev libnodeletlib-tools libmessage-filters-dev libimage-geometry-dev \
  libdiagnostic-msgs-dev ros-diagnostic-msgs libdiagnostic-updater-dev \
  libvisualization-msgs-dev ros-visualization-msgs libstd-srvs-dev ros-std-srvs \
  ros-core rosbash python3-rostest python3-rospy python3-rosbag python3-std-msgs python3-sensor-msgs \
- python3-geometry-msgs python3-numpy tf2-tools"
+ python3-geometry-msgs python3-std-srvs python3-diagnostic-msgs python3-numpy tf2-tools"
 EXTRA="clang libclang-rt-14-dev libfuzzer-14-dev rviz xvfb xauth"
 want="$CORE"
 for a in "$@"; do

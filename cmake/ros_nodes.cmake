@@ -1,0 +1,74 @@
+# ROS 1 targets: the ROS layer library (conversions, parameters, keyframe
+# store, stream reconstructor, nodelets), node executables, the bag
+# converter, and the ROS tests. Included at the end of the top-level
+# CMakeLists.txt when WILD_MVS_WITH_ROS is ON (after cmake/ros_setup.cmake).
+#
+# Test executables are ordinary targets (built by `all`), so a plain
+# `cmake --build build && ctest` runs the ROS tests too; `--target tests`
+# builds them as well.
+
+# --- the ROS layer ---------------------------------------------------------
+file(GLOB WILD_MVS_ROS_SRC CONFIGURE_DEPENDS src/ros/*.cpp)
+add_library(wild_mvs_ros SHARED ${WILD_MVS_ROS_SRC})
+target_include_directories(wild_mvs_ros PUBLIC
+  $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+  ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
+target_include_directories(wild_mvs_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
+target_link_libraries(wild_mvs_ros PUBLIC wild_mvs_io ${catkin_LIBRARIES})
+target_compile_options(wild_mvs_ros PRIVATE ${WILD_MVS_WARNINGS})
+add_dependencies(wild_mvs_ros ${PROJECT_NAME}_generate_messages_cpp
+  ${catkin_EXPORTED_TARGETS})
+
+# --- nodes and tools ---------------------------------------------------------
+set(WILD_MVS_ROS_EXECUTABLES)
+foreach(name depth_node fusion_node wild_mvs_to_bag)
+  if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/nodes/${name}.cpp)
+    add_executable(${name} src/nodes/${name}.cpp)
+    target_link_libraries(${name} PRIVATE wild_mvs_ros)
+    target_compile_options(${name} PRIVATE ${WILD_MVS_WARNINGS})
+    list(APPEND WILD_MVS_ROS_EXECUTABLES ${name})
+  endif()
+endforeach()
+if(TARGET wild_mvs_to_bag)
+  # `wild_mvs to-bag` finds it beside build/bin/wild_mvs.
+  add_custom_command(TARGET wild_mvs_to_bag POST_BUILD
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/bin
+    COMMAND ${CMAKE_COMMAND} -E create_symlink $<TARGET_FILE:wild_mvs_to_bag>
+            ${CMAKE_BINARY_DIR}/bin/wild_mvs_to_bag)
+endif()
+
+# --- tests -------------------------------------------------------------------
+if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
+  # Plain gtests of the ROS layer (no master needed).
+  file(GLOB WILD_MVS_ROS_UNIT_TESTS CONFIGURE_DEPENDS test/ros/test_*.cpp)
+  foreach(src ${WILD_MVS_ROS_UNIT_TESTS})
+    get_filename_component(name ${src} NAME_WE)
+    set(name ros_${name})
+    add_executable(${name} ${src})
+    target_link_libraries(${name} PRIVATE wild_mvs_ros wild_mvs_test_support
+      GTest::gtest GTest::gtest_main)
+    target_compile_options(${name} PRIVATE ${WILD_MVS_WARNINGS})
+    add_test(NAME ${name} COMMAND ${name})
+    set_tests_properties(${name} PROPERTIES TIMEOUT 300)
+  endforeach()
+
+  # rostests: each test/ros/*.test launches the nodes and a checker node
+  # built from test/ros/rostest_<name>.cpp (when present).
+  find_package(rostest REQUIRED)
+  file(GLOB WILD_MVS_ROSTEST_CHECKERS CONFIGURE_DEPENDS
+    test/ros/rostest_*.cpp)
+  set(WILD_MVS_ROSTEST_TARGETS)
+  foreach(src ${WILD_MVS_ROSTEST_CHECKERS})
+    get_filename_component(name ${src} NAME_WE)
+    add_executable(${name} ${src})
+    target_link_libraries(${name} PRIVATE wild_mvs_ros wild_mvs_test_support
+      GTest::gtest)
+    target_compile_options(${name} PRIVATE ${WILD_MVS_WARNINGS})
+    list(APPEND WILD_MVS_ROSTEST_TARGETS ${name})
+  endforeach()
+  file(GLOB WILD_MVS_ROSTESTS CONFIGURE_DEPENDS test/ros/*.test)
+  foreach(file ${WILD_MVS_ROSTESTS})
+    add_rostest(${file} DEPENDENCIES ${WILD_MVS_ROSTEST_TARGETS}
+      ${WILD_MVS_ROS_EXECUTABLES})
+  endforeach()
+endif()

@@ -1,0 +1,444 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/ros/conversions.h"
+
+#include <sensor_msgs/image_encodings.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/image.h"
+
+namespace wild_mvs {
+namespace ros1 {
+namespace enc = sensor_msgs::image_encodings;
+
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+bool Finite(double v) { return std::isfinite(v); }
+
+// Wraps msg.data as a cv::Mat of `type` after checking the layout.
+cv::Mat WrapImage(const sensor_msgs::Image& msg, int type,
+                  const std::string& what) {
+  Require(msg.width > 0 && msg.height > 0, what, ": empty image (", msg.width,
+          "x", msg.height, ")");
+  Require(msg.width <= 32768 && msg.height <= 32768, what, ": image of ",
+          msg.width, "x", msg.height, " is too large");
+  const size_t row_bytes = static_cast<size_t>(msg.width) * CV_ELEM_SIZE(type);
+  Require(msg.step >= row_bytes, what, ": step ", msg.step,
+          " is shorter than a row of ", msg.width, " pixels of encoding '",
+          msg.encoding, "' (", row_bytes, " bytes)");
+  Require(msg.data.size() >= static_cast<size_t>(msg.step) * msg.height, what,
+          ": data has ", msg.data.size(), " bytes, step * height = ",
+          static_cast<size_t>(msg.step) * msg.height);
+  const int bytes_per_channel = CV_ELEM_SIZE1(type);
+  const bool host_big_endian = false;  // x86 / ARM little endian
+  Require(bytes_per_channel == 1 || bool(msg.is_bigendian) == host_big_endian,
+          what, ": big-endian ", msg.encoding, " data is not supported");
+  Require(msg.step % bytes_per_channel == 0, what, ": step ", msg.step,
+          " is not a multiple of the channel size");
+  // const_cast: the Mat is only read (and cloned before it is kept).
+  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width),
+                 type, const_cast<uint8_t*>(msg.data.data()), msg.step);
+}
+
+sensor_msgs::Image MatToMsg(const cv::Mat& m, const std::string& encoding) {
+  sensor_msgs::Image msg;
+  msg.height = m.rows;
+  msg.width = m.cols;
+  msg.encoding = encoding;
+  msg.is_bigendian = 0;
+  msg.step = static_cast<uint32_t>(m.cols * m.elemSize());
+  msg.data.resize(static_cast<size_t>(msg.step) * m.rows);
+  for (int r = 0; r < m.rows; ++r)
+    std::memcpy(&msg.data[static_cast<size_t>(r) * msg.step], m.ptr(r),
+                msg.step);
+  return msg;
+}
+
+}  // namespace
+
+void CameraFromCameraInfo(const sensor_msgs::CameraInfo& info, Camera* camera,
+                          Distortion* distortion) {
+  const auto& K = info.K;
+  Require(info.width > 0 && info.height > 0, "camera_info: image size is ",
+          info.width, "x", info.height);
+  for (double v : K)
+    Require(Finite(v), "camera_info: K has a non-finite value");
+  Require(K[0] > 0 && K[4] > 0,
+          "camera_info: zero or negative focal length (fx=", K[0], " fy=", K[4],
+          ")");
+  Require(K[1] == 0, "camera_info: skew K[1] = ", K[1], " is not supported");
+  const double cx = K[2] + 0.5, cy = K[5] + 0.5;  // ROS -> core pixel centres
+  Require(cx > -double(info.width) && cx < 2.0 * info.width &&
+              cy > -double(info.height) && cy < 2.0 * info.height,
+          "camera_info: principal point (", K[2], ", ", K[5],
+          ") is far outside the ", info.width, "x", info.height, " image");
+  camera->fx = K[0];
+  camera->fy = K[4];
+  camera->cx = cx;
+  camera->cy = cy;
+  camera->width = static_cast<int>(info.width);
+  camera->height = static_cast<int>(info.height);
+  Distortion d;
+  const auto& D = info.D;
+  for (double v : D)
+    Require(Finite(v), "camera_info: D has a non-finite value");
+  bool any = std::any_of(D.begin(), D.end(), [](double v) { return v != 0; });
+  if (any) {
+    Require(info.distortion_model == "plumb_bob" ||
+                info.distortion_model == "rational_polynomial",
+            "camera_info: distortion model '", info.distortion_model,
+            "' is not supported (plumb_bob, rational_polynomial)");
+    for (size_t i = 5; i < D.size(); ++i)
+      Require(D[i] == 0, "camera_info: rational_polynomial coefficient D[", i,
+              "] = ", D[i], " is not supported");
+    d.model = Distortion::Model::kOpenCV;
+    d.k1 = D.size() > 0 ? D[0] : 0;
+    d.k2 = D.size() > 1 ? D[1] : 0;
+    d.p1 = D.size() > 2 ? D[2] : 0;
+    d.p2 = D.size() > 3 ? D[3] : 0;
+    d.k3 = D.size() > 4 ? D[4] : 0;
+  }
+  if (distortion) *distortion = d;
+}
+
+sensor_msgs::CameraInfo CameraInfoFromCamera(const Camera& camera) {
+  sensor_msgs::CameraInfo info;
+  info.width = camera.width;
+  info.height = camera.height;
+  info.distortion_model = "plumb_bob";
+  info.D.assign(5, 0.0);
+  const double cx = camera.cx - 0.5, cy = camera.cy - 0.5;  // core -> ROS
+  info.K = {camera.fx, 0, cx, 0, camera.fy, cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {camera.fx, 0, cx, 0, 0, camera.fy, cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+namespace {
+void SetPose(double qx, double qy, double qz, double qw, double x, double y,
+             double z, Camera* camera) {
+  for (double v : {qx, qy, qz, qw, x, y, z})
+    Require(Finite(v), "pose has a non-finite value (NaN or Inf)");
+  Eigen::Quaterniond q(qw, qx, qy, qz);
+  const double n = q.norm();
+  Require(n > 0.9 && n < 1.1, "pose quaternion has norm ", n,
+          " (not a rotation)");
+  q.normalize();
+  const Eigen::Matrix3d R_wc = q.toRotationMatrix();
+  const Eigen::Vector3d t_wc(x, y, z);
+  camera->R = R_wc.transpose();
+  camera->t = -R_wc.transpose() * t_wc;
+}
+}  // namespace
+
+void SetCameraPose(const geometry_msgs::Transform& T, Camera* camera) {
+  SetPose(T.rotation.x, T.rotation.y, T.rotation.z, T.rotation.w,
+          T.translation.x, T.translation.y, T.translation.z, camera);
+}
+
+void SetCameraPose(const geometry_msgs::Pose& P, Camera* camera) {
+  SetPose(P.orientation.x, P.orientation.y, P.orientation.z, P.orientation.w,
+          P.position.x, P.position.y, P.position.z, camera);
+}
+
+geometry_msgs::Pose PoseFromCamera(const Camera& camera) {
+  const Eigen::Matrix3d R_wc = camera.R.transpose();
+  const Eigen::Vector3d c = camera.Center();
+  Eigen::Quaterniond q(R_wc);
+  q.normalize();
+  geometry_msgs::Pose p;
+  p.position.x = c.x();
+  p.position.y = c.y();
+  p.position.z = c.z();
+  p.orientation.x = q.x();
+  p.orientation.y = q.y();
+  p.orientation.z = q.z();
+  p.orientation.w = q.w();
+  return p;
+}
+
+cv::Mat ImageToLinearRgb(const sensor_msgs::Image& msg, bool linearize) {
+  const std::string& e = msg.encoding;
+  const std::string what = "image (encoding '" + e + "')";
+  cv::Mat m;
+  if (e == enc::MONO8) {
+    m = WrapImage(msg, CV_8UC1, what);
+  } else if (e == enc::MONO16) {
+    m = WrapImage(msg, CV_16UC1, what);
+  } else if (e == enc::BGR8 || e == enc::RGB8) {
+    m = WrapImage(msg, CV_8UC3, what);
+  } else if (e == enc::BGR16 || e == enc::RGB16) {
+    m = WrapImage(msg, CV_16UC3, what);
+  } else if (e == enc::BGRA8 || e == enc::RGBA8) {
+    m = WrapImage(msg, CV_8UC4, what);
+  } else if (e == enc::TYPE_32FC1) {
+    m = WrapImage(msg, CV_32FC1, what);
+  } else if (e == enc::TYPE_32FC3) {
+    m = WrapImage(msg, CV_32FC3, what);
+  } else {
+    throw Error(Msg("image: unsupported encoding '", e,
+                    "' (expected mono8, mono16, rgb8, bgr8, rgba8, bgra8, "
+                    "rgb16, bgr16, 32FC1 or 32FC3)"));
+  }
+  // ToLinearRgb expects OpenCV's BGR(A) order.
+  cv::Mat bgr;
+  if (e == enc::RGB8 || e == enc::RGB16 || e == enc::TYPE_32FC3) {
+    cv::cvtColor(m, bgr, cv::COLOR_RGB2BGR);
+  } else if (e == enc::RGBA8) {
+    cv::cvtColor(m, bgr, cv::COLOR_RGBA2BGR);
+  } else {
+    bgr = m;
+  }
+  const bool is_float = m.depth() == CV_32F;
+  if (is_float) {
+    Require(cv::checkRange(bgr, true, nullptr, -1e6, 1e6), what,
+            ": non-finite pixel values");
+  }
+  cv::Mat out = ToLinearRgb(bgr, linearize && !is_float);
+  if (out.data == msg.data.data()) out = out.clone();  // never alias the msg
+  return out;
+}
+
+cv::Mat CompressedToLinearRgb(const sensor_msgs::CompressedImage& msg,
+                              bool linearize) {
+  Require(!msg.data.empty(), "compressed image: no data (format '", msg.format,
+          "')");
+  cv::Mat bgr;
+  try {
+    bgr = cv::imdecode(msg.data, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw Error(Msg("compressed image (format '", msg.format,
+                    "'): cannot decode: ", e.what()));
+  }
+  Require(!bgr.empty(), "compressed image (format '", msg.format,
+          "'): cannot decode ", msg.data.size(), " bytes");
+  return ToLinearRgb(bgr, linearize);
+}
+
+cv::Mat FloatImageFromMsg(const sensor_msgs::Image& msg, int channels,
+                          const std::string& what) {
+  const std::string want = channels == 1 ? enc::TYPE_32FC1 : enc::TYPE_32FC3;
+  Require(msg.encoding == want, what, ": encoding '", msg.encoding,
+          "', expected '", want, "'");
+  return WrapImage(msg, CV_MAKETYPE(CV_32F, channels), what).clone();
+}
+
+sensor_msgs::Image DepthToMsg(const cv::Mat& depth) {
+  Require(depth.type() == CV_32FC1, "DepthToMsg: depth must be CV_32FC1");
+  cv::Mat d = depth.clone();
+  d.forEach<float>([](float& v, const int*) {
+    if (!(v > 0) || !std::isfinite(v)) v = kNaN;
+  });
+  return MatToMsg(d, enc::TYPE_32FC1);
+}
+
+sensor_msgs::Image ConfidenceToMsg(const cv::Mat& confidence) {
+  Require(confidence.type() == CV_32FC1,
+          "ConfidenceToMsg: confidence must be CV_32FC1");
+  return MatToMsg(confidence, enc::TYPE_32FC1);
+}
+
+sensor_msgs::Image NormalsToMsg(const cv::Mat& normals) {
+  Require(normals.type() == CV_32FC3, "NormalsToMsg: normals must be CV_32FC3");
+  cv::Mat n = normals.clone();
+  n.forEach<cv::Vec3f>([](cv::Vec3f& v, const int*) {
+    if (v[0] == 0 && v[1] == 0 && v[2] == 0) v = cv::Vec3f(kNaN, kNaN, kNaN);
+  });
+  return MatToMsg(n, enc::TYPE_32FC3);
+}
+
+void FillDepthView(const DepthMap& dm, const std::string& world_frame,
+                   wild_mvs::DepthView* msg) {
+  Require(!dm.empty(), "FillDepthView: empty depth map");
+  msg->depth = DepthToMsg(dm.depth);
+  msg->confidence =
+      dm.confidence.empty()
+          ? ConfidenceToMsg(cv::Mat(dm.depth.size(), CV_32FC1, cv::Scalar(0)))
+          : ConfidenceToMsg(dm.confidence);
+  msg->normals =
+      dm.normal.empty()
+          ? NormalsToMsg(cv::Mat(dm.depth.size(), CV_32FC3, cv::Scalar::all(0)))
+          : NormalsToMsg(dm.normal);
+  msg->camera_info = CameraInfoFromCamera(dm.camera);
+  msg->camera_info.header = msg->header;
+  msg->depth.header = msg->confidence.header = msg->normals.header =
+      msg->header;
+  msg->camera_pose.header.stamp = msg->header.stamp;
+  msg->camera_pose.header.frame_id = world_frame;
+  msg->camera_pose.pose = PoseFromCamera(dm.camera);
+}
+
+DepthMap DepthMapFromDepthView(const wild_mvs::DepthView& msg) {
+  DepthMap dm;
+  dm.view = static_cast<int>(msg.keyframe_id);
+  CameraFromCameraInfo(msg.camera_info, &dm.camera, nullptr);
+  SetCameraPose(msg.camera_pose.pose, &dm.camera);
+  dm.depth = FloatImageFromMsg(msg.depth, 1, "depth_view.depth");
+  Require(dm.depth.cols == dm.camera.width && dm.depth.rows == dm.camera.height,
+          "depth_view: depth is ", dm.depth.cols, "x", dm.depth.rows,
+          " but camera_info is ", dm.camera.width, "x", dm.camera.height);
+  dm.confidence = FloatImageFromMsg(msg.confidence, 1, "depth_view.confidence");
+  dm.normal = FloatImageFromMsg(msg.normals, 3, "depth_view.normals");
+  Require(dm.confidence.size() == dm.depth.size() &&
+              dm.normal.size() == dm.depth.size(),
+          "depth_view: depth, confidence and normals differ in size");
+  for (int r = 0; r < dm.depth.rows; ++r) {
+    float* d = dm.depth.ptr<float>(r);
+    float* c = dm.confidence.ptr<float>(r);
+    cv::Vec3f* n = dm.normal.ptr<cv::Vec3f>(r);
+    for (int x = 0; x < dm.depth.cols; ++x) {
+      const bool normal_ok = std::isfinite(n[x][0]) && std::isfinite(n[x][1]) &&
+                             std::isfinite(n[x][2]);
+      if (!(d[x] > 0) || !std::isfinite(d[x]) || !std::isfinite(c[x]) ||
+          c[x] < 0 || c[x] > 1 || !normal_ok) {
+        d[x] = 0;
+        c[x] = 0;
+        n[x] = cv::Vec3f(0, 0, 0);
+      }
+    }
+  }
+  for (uint32_t id : msg.neighbor_ids) dm.neighbors.push_back(int(id));
+  return dm;
+}
+
+sensor_msgs::PointCloud2 CloudToMsg(const PointCloud& cloud,
+                                    size_t max_points) {
+  const size_t n = cloud.size();
+  const size_t stride = (max_points > 0 && n > max_points)
+                            ? (n + max_points - 1) / max_points
+                            : 1;
+  const size_t m = (n + stride - 1) / stride;
+  sensor_msgs::PointCloud2 msg;
+  sensor_msgs::PointCloud2Modifier mod(msg);
+  using PF = sensor_msgs::PointField;
+  std::vector<std::pair<std::string, int>> fields = {
+      {"x", PF::FLOAT32}, {"y", PF::FLOAT32}, {"z", PF::FLOAT32}};
+  if (cloud.has_rgb()) fields.push_back({"rgb", PF::FLOAT32});
+  if (cloud.has_normal()) {
+    fields.push_back({"normal_x", PF::FLOAT32});
+    fields.push_back({"normal_y", PF::FLOAT32});
+    fields.push_back({"normal_z", PF::FLOAT32});
+  }
+  if (cloud.has_confidence()) fields.push_back({"confidence", PF::FLOAT32});
+  msg.fields.clear();
+  uint32_t offset = 0;
+  for (const auto& [name, type] : fields) {
+    PF f;
+    f.name = name;
+    f.offset = offset;
+    f.datatype = type;
+    f.count = 1;
+    msg.fields.push_back(f);
+    offset += 4;
+  }
+  msg.point_step = offset;
+  msg.height = 1;
+  msg.width = static_cast<uint32_t>(m);
+  msg.row_step = msg.point_step * msg.width;
+  msg.is_bigendian = false;
+  msg.is_dense = true;
+  msg.data.resize(static_cast<size_t>(msg.row_step));
+  uint8_t* out = msg.data.data();
+  for (size_t i = 0; i < n; i += stride) {
+    float* f = reinterpret_cast<float*>(out);
+    int k = 0;
+    f[k++] = cloud.xyz[i].x();
+    f[k++] = cloud.xyz[i].y();
+    f[k++] = cloud.xyz[i].z();
+    if (cloud.has_rgb()) {
+      auto c8 = [](float v) {
+        return static_cast<uint32_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+      };
+      const uint32_t rgb = (c8(cloud.rgb[i].x()) << 16) |
+                           (c8(cloud.rgb[i].y()) << 8) | c8(cloud.rgb[i].z());
+      std::memcpy(&f[k++], &rgb, 4);
+    }
+    if (cloud.has_normal()) {
+      f[k++] = cloud.normal[i].x();
+      f[k++] = cloud.normal[i].y();
+      f[k++] = cloud.normal[i].z();
+    }
+    if (cloud.has_confidence()) f[k++] = cloud.confidence[i];
+    out += msg.point_step;
+  }
+  return msg;
+}
+
+PointCloud DepthMapToCloud(const DepthMap& dm, const cv::Mat& rgb) {
+  PointCloud cloud;
+  const bool colour = !rgb.empty() && rgb.type() == CV_32FC3;
+  for (int r = 0; r < dm.depth.rows; ++r) {
+    for (int c = 0; c < dm.depth.cols; ++c) {
+      const float z = dm.depth.at<float>(r, c);
+      if (!(z > 0) || !std::isfinite(z)) continue;
+      const Eigen::Vector2d px(c + 0.5, r + 0.5);
+      cloud.xyz.push_back(dm.camera.Backproject(px, z).cast<float>());
+      if (!dm.normal.empty()) {
+        const cv::Vec3f n = dm.normal.at<cv::Vec3f>(r, c);
+        cloud.normal.push_back(
+            (dm.camera.R.transpose() * Eigen::Vector3d(n[0], n[1], n[2]))
+                .cast<float>());
+      }
+      if (!dm.confidence.empty())
+        cloud.confidence.push_back(dm.confidence.at<float>(r, c));
+      if (colour) {
+        // Depth maps may be smaller than the image: sample proportionally.
+        const int ir = std::min(rgb.rows - 1, r * rgb.rows / dm.depth.rows);
+        const int ic = std::min(rgb.cols - 1, c * rgb.cols / dm.depth.cols);
+        const cv::Vec3f p = rgb.at<cv::Vec3f>(ir, ic);
+        cloud.rgb.emplace_back(LinearToSrgb(std::clamp(p[0], 0.f, 1.f)),
+                               LinearToSrgb(std::clamp(p[1], 0.f, 1.f)),
+                               LinearToSrgb(std::clamp(p[2], 0.f, 1.f)));
+      }
+    }
+  }
+  return cloud;
+}
+
+visualization_msgs::Marker MeshToMarker(const Mesh& mesh) {
+  visualization_msgs::Marker m;
+  m.type = visualization_msgs::Marker::TRIANGLE_LIST;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = 1.0;
+  m.color.r = m.color.g = m.color.b = 0.8f;
+  m.color.a = 1.0f;
+  const auto& V = mesh.vertices;
+  const bool colour = V.has_rgb();
+  m.points.reserve(mesh.faces.size() * 3);
+  if (colour) m.colors.reserve(mesh.faces.size() * 3);
+  for (const Eigen::Vector3i& f : mesh.faces) {
+    bool ok = true;
+    for (int k = 0; k < 3; ++k)
+      ok = ok && f[k] >= 0 && static_cast<size_t>(f[k]) < V.size();
+    if (!ok) continue;
+    for (int k = 0; k < 3; ++k) {
+      geometry_msgs::Point p;
+      p.x = V.xyz[f[k]].x();
+      p.y = V.xyz[f[k]].y();
+      p.z = V.xyz[f[k]].z();
+      m.points.push_back(p);
+      if (colour) {
+        std_msgs::ColorRGBA c;
+        c.r = V.rgb[f[k]].x();
+        c.g = V.rgb[f[k]].y();
+        c.b = V.rgb[f[k]].z();
+        c.a = 1.0f;
+        m.colors.push_back(c);
+      }
+    }
+  }
+  return m;
+}
+
+}  // namespace ros1
+}  // namespace wild_mvs
