@@ -1,6 +1,8 @@
 // Copyright wild_mvs authors.
 #include "wild_mvs/core/local_view_selection.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 
