@@ -1,0 +1,593 @@
+// Copyright wild_mvs authors. Sparse tracks from known poses.
+#include "wild_mvs/core/sparse_tracker.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <numeric>
+#include <set>
+#include <utility>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/triangulation.h"
+
+namespace wild_mvs {
+
+void TrackerOptions::Check() const {
+  features.Check();
+  Require(max_neighbors >= 1, "tracker.max_neighbors = ", max_neighbors,
+          " must be >= 1");
+  Require(min_overlap >= 0 && min_overlap <= 1,
+          "tracker.min_overlap = ", min_overlap, " must be in [0, 1]");
+  Require(max_pair_angle_deg > 0 && max_pair_angle_deg <= 180,
+          "tracker.max_pair_angle_deg = ", max_pair_angle_deg,
+          " must be in (0, 180]");
+  Require(scene_depth >= 0 && std::isfinite(scene_depth),
+          "tracker.scene_depth = ", scene_depth, " must be >= 0 (0 = auto)");
+  Require(max_epipolar_distance > 0,
+          "tracker.max_epipolar_distance = ", max_epipolar_distance,
+          " must be > 0");
+  Require(ratio > 0 && ratio <= 1, "tracker.ratio = ", ratio,
+          " must be in (0, 1]");
+  Require(max_descriptor_distance > 0 && max_descriptor_distance <= 2,
+          "tracker.max_descriptor_distance = ", max_descriptor_distance,
+          " must be in (0, 2]");
+  Require(max_reprojection_error > 0,
+          "tracker.max_reprojection_error = ", max_reprojection_error,
+          " must be > 0");
+  Require(max_outlier_removals >= 0,
+          "tracker.max_outlier_removals = ", max_outlier_removals,
+          " must be >= 0");
+  Require(min_triangulation_angle_deg >= 0 && min_triangulation_angle_deg < 90,
+          "tracker.min_triangulation_angle_deg = ", min_triangulation_angle_deg,
+          " must be in [0, 90)");
+  Require(min_track_length >= 2,
+          "tracker.min_track_length = ", min_track_length, " must be >= 2");
+  Require(refine_iterations >= 0,
+          "tracker.refine_iterations = ", refine_iterations, " must be >= 0");
+}
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+struct ViewData {
+  int id = -1;
+  Camera camera;
+  Features features;
+  int offset = 0;  // first union-find node of this view
+  int count = 0;   // number of features (nodes)
+  bool removed = false;
+  std::vector<int> neighbors;  // ids matched against when added
+};
+
+struct PointData {
+  bool valid = false;
+  bool conflict = false;
+  SparsePoint point;
+};
+
+using Match = std::pair<int, int>;  // (feature in new view, feature in old)
+
+// Matches features of view a to view b along the epipolar geometry.
+std::vector<Match> MatchPair(const ViewData& a, const ViewData& b,
+                             const TrackerOptions& opt) {
+  const Features& fa = a.features;
+  const Features& fb = b.features;
+  const int na = fa.size(), nb = fb.size();
+  std::vector<Match> out;
+  if (na == 0 || nb == 0) return out;
+  // x_b^T F x_a = 0.
+  const Eigen::Matrix3f F = FundamentalMatrix(a.camera, b.camera).cast<float>();
+  const float thr = static_cast<float>(opt.max_epipolar_distance);
+  std::vector<float> bx(nb), by(nb);
+  for (int j = 0; j < nb; ++j) {
+    bx[j] = fb.xy[j].x();
+    by[j] = fb.xy[j].y();
+  }
+  // Epipolar lines of b's features in a (F^T x_b), normalised.
+  std::vector<Eigen::Vector3f> lines_in_a(nb);
+  for (int j = 0; j < nb; ++j) {
+    Eigen::Vector3f l = F.transpose() * Eigen::Vector3f(bx[j], by[j], 1.0f);
+    const float n = l.head<2>().norm();
+    lines_in_a[j] = n > 0 ? Eigen::Vector3f(l / n) : Eigen::Vector3f::Zero();
+  }
+  constexpr int kNone = -1;
+  const int kInf = std::numeric_limits<int>::max();
+  std::vector<int> best_a(na, kNone), d1_a(na, kInf), d2_a(na, kInf);
+  std::vector<int> best_b(nb, kNone), d1_b(nb, kInf), d2_b(nb, kInf);
+  std::vector<int> cand;
+  cand.reserve(256);
+  for (int i = 0; i < na; ++i) {
+    const Eigen::Vector2f& p = fa.xy[i];
+    Eigen::Vector3f l = F * Eigen::Vector3f(p.x(), p.y(), 1.0f);
+    const float n = l.head<2>().norm();
+    if (!(n > 0)) continue;
+    l /= n;
+    const float la = l.x(), lb = l.y(), lc = l.z();
+    cand.clear();
+    for (int j = 0; j < nb; ++j) {
+      if (std::abs(la * bx[j] + lb * by[j] + lc) <= thr) cand.push_back(j);
+    }
+    const uint8_t* da = fa.descriptors.ptr<uint8_t>(i);
+    for (int j : cand) {
+      const Eigen::Vector3f& m = lines_in_a[j];
+      if (!(std::abs(m.x() * p.x() + m.y() * p.y() + m.z()) <= thr)) continue;
+      const int d =
+          DescriptorDistanceSquared(da, fb.descriptors.ptr<uint8_t>(j));
+      if (d < d1_a[i]) {
+        d2_a[i] = d1_a[i];
+        d1_a[i] = d;
+        best_a[i] = j;
+      } else if (d < d2_a[i]) {
+        d2_a[i] = d;
+      }
+      if (d < d1_b[j]) {
+        d2_b[j] = d1_b[j];
+        d1_b[j] = d;
+        best_b[j] = i;
+      } else if (d < d2_b[j]) {
+        d2_b[j] = d;
+      }
+    }
+  }
+  const double max_d = opt.max_descriptor_distance * Features::kDescriptorScale;
+  const double max_d2 = max_d * max_d;
+  const double r2 = opt.ratio * opt.ratio;
+  auto passes = [&](int d1, int d2) {
+    if (d1 > max_d2) return false;
+    return d2 == kInf || static_cast<double>(d1) < r2 * d2;
+  };
+  for (int i = 0; i < na; ++i) {
+    const int j = best_a[i];
+    if (j == kNone || !passes(d1_a[i], d2_a[i])) continue;
+    if (opt.mutual && (best_b[j] != i || !passes(d1_b[j], d2_b[j]))) continue;
+    out.emplace_back(i, j);
+  }
+  return out;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+}  // namespace
+
+struct SparseTracker::Impl {
+  TrackerOptions opt;
+  ThreadPool* pool = nullptr;
+  std::vector<ViewData> views;              // in the order added
+  std::map<int, int> slot_of_id;            // view id -> index into views
+  std::vector<int> parent;                  // union-find over features
+  std::vector<int> node_slot;               // view slot of each node
+  std::map<int, std::vector<int>> members;  // root -> nodes (size >= 2)
+  std::map<int, PointData> points;          // root -> triangulated track
+  int pairs_matched = 0;
+  long long matches = 0;
+
+  int Find(int x) {
+    while (parent[x] != x) {
+      parent[x] = parent[parent[x]];
+      x = parent[x];
+    }
+    return x;
+  }
+
+  // Unites the components of a and b; returns the new root.
+  int Union(int a, int b) {
+    int ra = Find(a), rb = Find(b);
+    if (ra == rb) return ra;
+    auto size_of = [this](int r) {
+      auto it = members.find(r);
+      return it == members.end() ? size_t{1} : it->second.size();
+    };
+    // Larger component stays root; ties to the smaller index.
+    const size_t sa = size_of(ra), sb = size_of(rb);
+    if (sa < sb || (sa == sb && rb < ra)) std::swap(ra, rb);
+    std::vector<int>& into = members[ra];
+    if (into.empty()) into.push_back(ra);
+    auto it = members.find(rb);
+    if (it == members.end()) {
+      into.push_back(rb);
+    } else {
+      into.insert(into.end(), it->second.begin(), it->second.end());
+      members.erase(it);
+    }
+    points.erase(rb);
+    parent[rb] = ra;
+    return ra;
+  }
+
+  // Typical depth of the scene seen by `cam` (0 = unknown).
+  double EstimateDepth(const Camera& cam) const {
+    if (opt.scene_depth > 0) return opt.scene_depth;
+    std::vector<double> depths;
+    for (const auto& kv : points) {
+      if (!kv.second.valid) continue;
+      Eigen::Vector2d px;
+      const Eigen::Vector3d& X = kv.second.point.xyz;
+      if (cam.Project(X, &px) && cam.InImage(px))
+        depths.push_back(cam.Depth(X));
+    }
+    if (depths.size() >= 20) return Median(depths);
+    // Convergence of the optical axes.
+    depths.clear();
+    const Eigen::Vector3d c0 = cam.Center(), d0 = cam.ViewDirection();
+    for (const ViewData& v : views) {
+      if (v.removed) continue;
+      const Eigen::Vector3d c1 = v.camera.Center(),
+                            d1 = v.camera.ViewDirection();
+      const double b = d0.dot(d1);
+      const double den = 1 - b * b;
+      if (den < std::pow(std::sin(1.0 * kDeg), 2)) continue;  // ~parallel
+      const Eigen::Vector3d w = c0 - c1;
+      const double s = (b * d1.dot(w) - d0.dot(w)) / den;
+      const double t = (d1.dot(w) - b * d0.dot(w)) / den;
+      if (s > 0 && t > 0) depths.push_back(s);
+    }
+    return depths.empty() ? 0 : Median(depths);
+  }
+
+  // Fraction of sample points of cam's frustum (image grid x depths) that
+  // project into other's image in front of it.
+  static double Overlap(const Camera& cam, const Camera& other,
+                        const std::vector<double>& depths) {
+    constexpr int kGx = 8, kGy = 6;
+    int in = 0, total = 0;
+    for (double d : depths) {
+      for (int gy = 0; gy < kGy; ++gy) {
+        for (int gx = 0; gx < kGx; ++gx) {
+          const Eigen::Vector2d px((gx + 0.5) * cam.width / kGx,
+                                   (gy + 0.5) * cam.height / kGy);
+          Eigen::Vector2d q;
+          ++total;
+          if (other.Project(cam.Backproject(px, d), &q) && other.InImage(q)) {
+            ++in;
+          }
+        }
+      }
+    }
+    return total ? static_cast<double>(in) / total : 0.0;
+  }
+
+  std::vector<int> SelectNeighbors(const Camera& cam) const {
+    const double depth = EstimateDepth(cam);
+    const Eigen::Vector3d c = cam.Center();
+    const double min_angle = opt.min_triangulation_angle_deg * kDeg;
+    std::vector<std::pair<double, int>> scored;  // (-score, slot)
+    for (size_t s = 0; s < views.size(); ++s) {
+      const ViewData& v = views[s];
+      if (v.removed) continue;
+      const double axis_angle = std::acos(std::min(
+          1.0,
+          std::max(-1.0, cam.ViewDirection().dot(v.camera.ViewDirection()))));
+      if (axis_angle > opt.max_pair_angle_deg * kDeg) continue;
+      const double b = (v.camera.Center() - c).norm();
+      if (!(b > 0)) continue;
+      double score = 0;
+      if (depth > 0) {
+        const double overlap =
+            Overlap(cam, v.camera,
+                    {0.5 * depth, std::sqrt(0.5) * depth, depth,
+                     std::sqrt(2.0) * depth, 2 * depth});
+        if (overlap < opt.min_overlap) continue;
+        const Eigen::Vector3d X = cam.Backproject(
+            Eigen::Vector2d(0.5 * cam.width, 0.5 * cam.height), depth);
+        const double angle = TriangulationAngle(c, v.camera.Center(), X);
+        // Too small an angle at the typical depth: only far-off structure
+        // would pass the angle filter.
+        if (angle < 0.5 * min_angle) continue;
+        score = overlap * std::min(1.0, angle / (10 * kDeg));
+      } else {
+        // Unknown depth: sweep the depths at which the pair's triangulation
+        // angle lies between ~60 degrees and the minimum angle.
+        const double far = b / std::tan(std::max(min_angle, 0.5 * kDeg));
+        std::vector<double> depths;
+        for (double d = b; d <= far * 1.0001; d *= 2) depths.push_back(d);
+        score = Overlap(cam, v.camera, depths);
+        if (score < opt.min_overlap) continue;
+      }
+      scored.emplace_back(-score, static_cast<int>(s));
+    }
+    std::sort(scored.begin(), scored.end());
+    std::vector<int> slots;
+    for (size_t k = 0;
+         k < scored.size() && static_cast<int>(k) < opt.max_neighbors; ++k) {
+      slots.push_back(scored[k].second);
+    }
+    return slots;
+  }
+
+  // Re-triangulates the component with this root.
+  void Rebuild(int root) {
+    auto mit = members.find(root);
+    if (mit == members.end()) {
+      points.erase(root);
+      return;
+    }
+    PointData pd;
+    std::vector<int> nodes;
+    std::set<int> seen_slots;
+    for (int n : mit->second) {
+      const int s = node_slot[n];
+      if (views[s].removed) continue;
+      if (!seen_slots.insert(s).second) pd.conflict = true;
+      nodes.push_back(n);
+    }
+    if (pd.conflict || static_cast<int>(nodes.size()) < opt.min_track_length) {
+      points[root] = pd;
+      return;
+    }
+    std::sort(nodes.begin(), nodes.end(), [this](int x, int y) {
+      return views[node_slot[x]].id < views[node_slot[y]].id;
+    });
+    std::vector<TriangulationInput> obs;
+    for (int n : nodes) {
+      const ViewData& v = views[node_slot[n]];
+      obs.push_back({&v.camera, v.features.xy[n - v.offset].cast<double>()});
+    }
+    Eigen::Vector3d X;
+    bool ok = Triangulate(obs, &X, opt.refine_iterations);
+    std::vector<double> err(obs.size());
+    for (int removal = 0; ok; ++removal) {
+      size_t worst = 0;
+      for (size_t k = 0; k < obs.size(); ++k) {
+        err[k] = ReprojectionError(*obs[k].camera, X, obs[k].xy);
+        if (!(err[k] <= err[worst])) worst = k;
+      }
+      if (err[worst] <= opt.max_reprojection_error) break;
+      if (removal >= opt.max_outlier_removals ||
+          static_cast<int>(obs.size()) <= opt.min_track_length) {
+        ok = false;
+        break;
+      }
+      obs.erase(obs.begin() + worst);
+      nodes.erase(nodes.begin() + worst);
+      err.pop_back();
+      ok = Triangulate(obs, &X, opt.refine_iterations);
+    }
+    if (ok) {
+      for (const TriangulationInput& o : obs) {
+        if (!(o.camera->Depth(X) > 0)) ok = false;
+      }
+    }
+    if (ok && MaxTriangulationAngle(obs, X) <
+                  opt.min_triangulation_angle_deg * kDeg) {
+      ok = false;
+    }
+    if (!ok) {
+      points[root] = pd;
+      return;
+    }
+    pd.valid = true;
+    SparsePoint& p = pd.point;
+    p.xyz = X;
+    Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
+    double sum_err = 0;
+    for (size_t k = 0; k < nodes.size(); ++k) {
+      const ViewData& v = views[node_slot[nodes[k]]];
+      const int f = nodes[k] - v.offset;
+      Observation o;
+      o.view = v.id;
+      o.xy = obs[k].xy;
+      o.scale = v.features.scale[f];
+      p.track.push_back(o);
+      if (!v.features.rgb.empty()) rgb += v.features.rgb[f].cast<float>();
+      sum_err += err[k];
+    }
+    p.rgb = MeanColour(rgb, nodes.size());
+    p.error = sum_err / nodes.size();
+    points[root] = std::move(pd);
+  }
+
+  static Eigen::Vector3f MeanColour(const Eigen::Vector3f& sum, size_t n) {
+    return n ? Eigen::Vector3f(sum / (255.0f * n))
+             : Eigen::Vector3f(0.5f, 0.5f, 0.5f);
+  }
+};
+
+SparseTracker::SparseTracker(const TrackerOptions& options, ThreadPool* pool)
+    : impl_(new Impl) {
+  options.Check();
+  impl_->opt = options;
+  impl_->pool = pool;
+}
+
+SparseTracker::~SparseTracker() = default;
+
+void SparseTracker::AddView(int view_index, const Camera& camera,
+                            const cv::Mat& image) {
+  Require(!image.empty(), "SparseTracker::AddView: view ", view_index,
+          " has an empty image");
+  Require(image.cols == camera.width && image.rows == camera.height,
+          "SparseTracker::AddView: view ", view_index, " image is ", image.cols,
+          "x", image.rows, " but its camera is ", camera.width, "x",
+          camera.height);
+  AddView(view_index, camera, ExtractFeatures(image, impl_->opt.features));
+}
+
+void SparseTracker::AddView(int view_index, const Camera& camera,
+                            Features features) {
+  Impl& m = *impl_;
+  Require(view_index >= 0, "SparseTracker::AddView: view index ", view_index,
+          " must be >= 0");
+  Require(!m.slot_of_id.count(view_index), "SparseTracker::AddView: view ",
+          view_index, " was already added");
+  camera.Validate(Msg("SparseTracker::AddView view ", view_index));
+  const int n = features.size();
+  Require(static_cast<int>(features.scale.size()) == n &&
+              (features.rgb.empty() ||
+               static_cast<int>(features.rgb.size()) == n) &&
+              (n == 0 || (features.descriptors.type() == CV_8U &&
+                          features.descriptors.rows == n &&
+                          features.descriptors.cols == 128)),
+          "SparseTracker::AddView: view ", view_index,
+          " has inconsistent features (", n, " positions, ",
+          features.descriptors.rows, " descriptors)");
+  if (m.opt.features.max_features > 0 && n > m.opt.features.max_features) {
+    std::vector<int> keep(m.opt.features.max_features);
+    std::iota(keep.begin(), keep.end(), 0);
+    features.Select(keep);
+  }
+
+  ViewData v;
+  v.id = view_index;
+  v.camera = camera;
+  v.features = std::move(features);
+  v.count = v.features.size();
+  v.offset = static_cast<int>(m.parent.size());
+
+  const std::vector<int> nb = m.SelectNeighbors(camera);
+  std::vector<std::vector<Match>> matches(nb.size());
+  auto run = [&](int k) { matches[k] = MatchPair(v, m.views[nb[k]], m.opt); };
+  if (m.pool && nb.size() > 1) {
+    m.pool->ParallelFor(static_cast<int>(nb.size()), run);
+  } else {
+    for (size_t k = 0; k < nb.size(); ++k) run(static_cast<int>(k));
+  }
+
+  const int slot = static_cast<int>(m.views.size());
+  for (int s : nb) v.neighbors.push_back(m.views[s].id);
+  m.views.push_back(std::move(v));
+  m.slot_of_id[view_index] = slot;
+  const ViewData& nv = m.views.back();
+  for (int i = 0; i < nv.count; ++i) {
+    m.parent.push_back(nv.offset + i);
+    m.node_slot.push_back(slot);
+  }
+  std::vector<int> touched;
+  for (size_t k = 0; k < nb.size(); ++k) {
+    const ViewData& old = m.views[nb[k]];
+    if (!matches[k].empty()) ++m.pairs_matched;
+    m.matches += static_cast<long long>(matches[k].size());
+    for (const Match& mt : matches[k]) {
+      touched.push_back(m.Union(nv.offset + mt.first, old.offset + mt.second));
+    }
+  }
+  std::set<int> roots;
+  for (int r : touched) roots.insert(m.Find(r));
+  for (int r : roots) m.Rebuild(r);
+}
+
+void SparseTracker::RemoveView(int view_index) {
+  Impl& m = *impl_;
+  auto it = m.slot_of_id.find(view_index);
+  if (it == m.slot_of_id.end()) return;
+  ViewData& v = m.views[it->second];
+  if (v.removed) return;
+  v.removed = true;
+  std::set<int> roots;
+  for (int i = 0; i < v.count; ++i) {
+    const int r = m.Find(v.offset + i);
+    if (m.members.count(r)) roots.insert(r);
+  }
+  for (int r : roots) m.Rebuild(r);
+  v.features = Features();  // free descriptors; positions no longer needed
+  m.slot_of_id.erase(it);
+}
+
+bool SparseTracker::HasView(int view_index) const {
+  return impl_->slot_of_id.count(view_index) > 0;
+}
+
+std::vector<int> SparseTracker::MatchedNeighbors(int view_index) const {
+  auto it = impl_->slot_of_id.find(view_index);
+  if (it == impl_->slot_of_id.end()) return {};
+  return impl_->views[it->second].neighbors;
+}
+
+std::vector<SparsePoint> SparseTracker::Points() const {
+  std::vector<SparsePoint> out;
+  for (const auto& kv : impl_->points) {
+    if (kv.second.valid) out.push_back(kv.second.point);
+  }
+  return out;
+}
+
+void SparseTracker::FillScene(Scene* scene) const {
+  std::vector<SparsePoint> pts = Points();
+  for (const SparsePoint& p : pts) {
+    for (const Observation& o : p.track) {
+      Require(o.view >= 0 && o.view < static_cast<int>(scene->views.size()),
+              "SparseTracker::FillScene: view index ", o.view,
+              " is not a view of the scene (", scene->views.size(), " views)");
+    }
+  }
+  scene->points = std::move(pts);
+}
+
+TrackerStats SparseTracker::Stats() const {
+  const Impl& m = *impl_;
+  TrackerStats s;
+  for (const ViewData& v : m.views) {
+    if (v.removed) continue;
+    ++s.views;
+    s.features += v.count;
+  }
+  s.pairs_matched = m.pairs_matched;
+  s.matches = m.matches;
+  s.tracks = static_cast<int>(m.members.size());
+  for (const auto& kv : m.points) {
+    if (kv.second.conflict) ++s.conflicting_tracks;
+    if (kv.second.valid) ++s.points;
+  }
+  return s;
+}
+
+size_t SparseTracker::bytes() const {
+  const Impl& m = *impl_;
+  size_t b = (m.parent.capacity() + m.node_slot.capacity()) * sizeof(int);
+  for (const ViewData& v : m.views) b += sizeof(ViewData) + v.features.bytes();
+  for (const auto& kv : m.members) b += 64 + kv.second.capacity() * sizeof(int);
+  for (const auto& kv : m.points) {
+    b += 96 + kv.second.point.track.capacity() * sizeof(Observation);
+  }
+  return b;
+}
+
+std::vector<SparsePoint> ComputeSparseTracks(const Scene& scene,
+                                             ImageCache& images,
+                                             const TrackerOptions& options,
+                                             ThreadPool* pool,
+                                             TrackerStats* stats) {
+  options.Check();
+  SparseTracker tracker(options, pool);
+  const int n = static_cast<int>(scene.views.size());
+  // Extract in chunks so only a few images / feature sets are held at once.
+  const int chunk = pool ? std::max(2, 2 * (pool->size() + 1)) : 1;
+  for (int start = 0; start < n; start += chunk) {
+    const int count = std::min(chunk, n - start);
+    std::vector<Features> feats(count);
+    auto extract = [&](int k) {
+      const int i = start + k;
+      const View& view = scene.views[i];
+      std::shared_ptr<const cv::Mat> img = images.Get(i);
+      Require(img && !img->empty(), "ComputeSparseTracks: view ", i, " (",
+              view.name, ") has no image");
+      Require(img->cols == view.camera.width && img->rows == view.camera.height,
+              "ComputeSparseTracks: view ", i, " (", view.name, ") image is ",
+              img->cols, "x", img->rows, " but its camera is ",
+              view.camera.width, "x", view.camera.height);
+      feats[k] = ExtractFeatures(*img, options.features);
+    };
+    if (pool && count > 1) {
+      pool->ParallelFor(count, extract);
+    } else {
+      for (int k = 0; k < count; ++k) extract(k);
+    }
+    for (int k = 0; k < count; ++k) {
+      tracker.AddView(start + k, scene.views[start + k].camera,
+                      std::move(feats[k]));
+    }
+  }
+  if (stats) *stats = tracker.Stats();
+  return tracker.Points();
+}
+
+}  // namespace wild_mvs

@@ -1,0 +1,104 @@
+// Copyright wild_mvs authors. Sparse tracks on real data with known cameras:
+// Middlebury templeSparseRing (16 views, 640x480). Skipped when ../shared is
+// absent.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_paths.h"
+#include "wild_mvs/core/image.h"
+#include "wild_mvs/core/scene.h"
+#include "wild_mvs/core/sparse_tracker.h"
+#include "wild_mvs/core/thread_pool.h"
+#include "wild_mvs/core/triangulation.h"
+
+namespace wild_mvs {
+namespace {
+
+// Minimal reading of a Middlebury *_par.txt (the io layer has the full,
+// validating reader; this test only needs the cameras).
+Scene LoadPar(const std::string& dir, const std::string& par) {
+  std::ifstream in(dir + "/" + par);
+  Scene scene;
+  int n = 0;
+  in >> n;
+  for (int i = 0; i < n; ++i) {
+    View v;
+    double k[9], r[9], t[3];
+    in >> v.name;
+    for (double& x : k) in >> x;
+    for (double& x : r) in >> x;
+    for (double& x : t) in >> x;
+    v.image_path = dir + "/" + v.name;
+    Camera& c = v.camera;
+    c.fx = k[0];
+    c.fy = k[4];
+    c.cx = k[2] + 0.5;  // Middlebury: integer pixel centres
+    c.cy = k[5] + 0.5;
+    c.width = 640;
+    c.height = 480;
+    Eigen::Matrix3d R;
+    R << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
+    c.R = NearestRotation(R);
+    c.t = Eigen::Vector3d(t[0], t[1], t[2]);
+    scene.views.push_back(v);
+  }
+  EXPECT_TRUE(in.good());
+  return scene;
+}
+
+TEST(SparseTrackerReal, TempleSparseRing) {
+  WILD_MVS_REQUIRE_SHARED(dir, "datasets/middlebury_templeSparseRing");
+  Scene scene = LoadPar(dir, "templeSR_par.txt");
+  ASSERT_EQ(scene.views.size(), 16u);
+  ImageOptions io;
+  ImageCache cache(MakeSceneLoader(scene, io), 256);
+  TrackerOptions opt;
+  ThreadPool pool(2);
+  TrackerStats stats;
+  const std::vector<SparsePoint> pts =
+      ComputeSparseTracks(scene, cache, opt, &pool, &stats);
+  std::vector<double> errors;
+  std::vector<int> hist(8, 0);
+  int inside = 0;
+  // README.txt bounding box, with a 10 % margin.
+  const Eigen::Vector3d lo(-0.073568, 0.021728, -0.012445),
+      hi(0.028855, 0.181892, 0.062736);
+  const Eigen::Vector3d margin = 0.1 * (hi - lo);
+  for (const SparsePoint& p : pts) {
+    ASSERT_GE(p.track.size(), 2u);
+    hist[std::min<size_t>(p.track.size(), 7)]++;
+    for (const Observation& o : p.track) {
+      const Camera& c = scene.views[o.view].camera;
+      ASSERT_GT(c.Depth(p.xyz), 0);
+      const double e = ReprojectionError(c, p.xyz, o.xy);
+      ASSERT_LE(e, opt.max_reprojection_error + 1e-9);
+      EXPECT_GT(o.scale, 0);
+      errors.push_back(e);
+    }
+    if ((p.xyz.array() >= (lo - margin).array()).all() &&
+        (p.xyz.array() <= (hi + margin).array()).all()) {
+      ++inside;
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  const double median = errors.empty() ? 1e9 : errors[errors.size() / 2];
+  std::cout << "templeSparseRing: " << pts.size() << " points, "
+            << errors.size() << " observations, " << stats.features
+            << " features, " << stats.pairs_matched << " pairs, "
+            << stats.matches << " matches, " << stats.conflicting_tracks
+            << " conflicting tracks; median reprojection error " << median
+            << " px; inside bbox " << inside << "; track lengths 2..7+:";
+  for (int k = 2; k < 8; ++k) std::cout << " " << hist[k];
+  std::cout << std::endl;
+  EXPECT_GE(pts.size(), 2000u);
+  EXPECT_LT(median, 0.5);
+  EXPECT_GE(inside, 0.9 * pts.size());
+}
+
+}  // namespace
+}  // namespace wild_mvs
