@@ -18,12 +18,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <filesystem>
+#include <cstdio>
 #include <limits>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/thread_pool.h"
+#include "wild_mvs/io/atomic_file.h"
+#include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/pfm.h"
 
 namespace wild_mvs {
 namespace testing {
@@ -651,9 +655,31 @@ SyntheticSpec ClutteredSceneSpec(bool vary_lighting, bool occluder) {
 // ---------------------------------------------------------------- dataset
 
 void WriteDataset(const SyntheticScene& s, const std::string& dir) {
-  (void)s;
-  throw Error(Msg("WriteDataset(", dir,
-                  "): not available yet (needs the COLMAP/PFM writers)"));
+  Require(s.images.size() == s.scene.views.size() &&
+              s.depth.size() == s.scene.views.size(),
+          "WriteDataset(", dir, "): scene has ", s.scene.views.size(),
+          " views but ", s.images.size(), " images");
+  WriteColmapText(s.scene, dir + "/sparse");
+  for (size_t i = 0; i < s.images.size(); ++i) {
+    const View& v = s.scene.views[i];
+    // Linear -> 8-bit sRGB. When the scene was rendered with quantize, the
+    // images hold exact 8-bit sRGB levels, so LoadViewImage of this PNG
+    // returns `images[i]` exactly.
+    cv::Mat out(s.images[i].size(), CV_8UC3);
+    for (int r = 0; r < out.rows; ++r) {
+      const auto* ip = s.images[i].ptr<cv::Vec3f>(r);
+      auto* op = out.ptr<cv::Vec3b>(r);
+      for (int c = 0; c < out.cols; ++c)
+        for (int k = 0; k < 3; ++k)  // RGB -> BGR for OpenCV
+          op[c][2 - k] = cv::saturate_cast<uchar>(
+              std::round(LinearToSrgb(std::clamp(ip[c][k], 0.f, 1.f)) * 255.f));
+    }
+    const std::string path = dir + "/images/" + v.name;
+    ProduceFileAtomically(path, [&](const std::string& tmp) {
+      return cv::imwrite(tmp, out);  // tmp keeps the .png extension
+    });
+    WritePfm(dir + "/gt_depth/" + v.Stem() + ".pfm", s.depth[i]);
+  }
 }
 
 }  // namespace testing

@@ -4,12 +4,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "synthetic_scene.h"
+#include "test_paths.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/pfm.h"
 
 namespace wild_mvs {
 namespace testing {
@@ -427,6 +431,42 @@ TEST(Synthetic, LoaderServesTheImages) {
     EXPECT_EQ(cv::norm(*img, s.images[i], cv::NORM_INF), 0.0);
   }
   EXPECT_THROW(cache.Get(5), Error);
+}
+
+TEST(Synthetic, WriteDatasetRoundTrips) {
+  SyntheticSpec spec = SlantedPlaneSpec(25, 3);
+  spec.width = 96;
+  spec.height = 64;
+  spec.focal = 90;
+  spec.num_sparse_points = 50;
+  const SyntheticScene s = Render(spec);
+  const std::string dir = MakeTempDir("synthetic_dataset");
+  WriteDataset(s, dir);
+  const Scene back = ReadColmapModel(dir + "/sparse", dir + "/images");
+  ASSERT_EQ(back.views.size(), 3u);
+  ASSERT_EQ(back.points.size(), s.scene.points.size());
+  for (int i = 0; i < 3; ++i) {
+    const View& v = back.views[i];
+    EXPECT_EQ(v.name, s.scene.views[i].name);
+    const Camera& a = v.camera;
+    const Camera& b = s.scene.views[i].camera;
+    EXPECT_NEAR((a.K() - b.K()).norm(), 0, 1e-9);
+    EXPECT_NEAR((a.R - b.R).norm(), 0, 1e-9);
+    EXPECT_NEAR((a.t - b.t).norm(), 0, 1e-9);
+    // Images: the 8-bit sRGB PNG loads back to exactly the rendered image.
+    const cv::Mat img = LoadViewImage(v, ImageOptions());
+    EXPECT_LT(cv::norm(img, s.images[i], cv::NORM_INF), 1e-6);
+    const cv::Mat d = ReadPfm(dir + "/gt_depth/" + v.Stem() + ".pfm");
+    EXPECT_EQ(cv::norm(d, s.depth[i], cv::NORM_INF), 0.0);
+  }
+  for (size_t k = 0; k < back.points.size(); ++k) {
+    EXPECT_NEAR((back.points[k].xyz - s.scene.points[k].xyz).norm(), 0, 1e-9);
+    ASSERT_EQ(back.points[k].track.size(), s.scene.points[k].track.size());
+    EXPECT_NEAR(
+        (back.points[k].track[0].xy - s.scene.points[k].track[0].xy).norm(), 0,
+        1e-6);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Synthetic, BadSpecsAreRejected) {
