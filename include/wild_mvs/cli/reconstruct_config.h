@@ -1,0 +1,40 @@
+// Copyright wild_mvs authors. Every option of `wild_mvs reconstruct` (and of
+// sparse / fuse / mesh) in one struct, with its YAML key and flag.
+//
+// The keys are section.key where the section names the option struct:
+//   run.*      the tool itself (threads, stages)
+//   image.*    ImageOptions (image loading and cache)
+// The default config file config/reconstruct.yaml is exactly
+// `wild_mvs reconstruct --dump-config` with the defaults (a test checks it).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "wild_mvs/cli/option_set.h"
+#include "wild_mvs/core/image.h"
+
+namespace wild_mvs {
+namespace cli {
+
+struct RunOptions {
+  // Worker threads; 0 = one per core. Results do not depend on it.
+  int threads = 0;
+  // Stages of `reconstruct`, comma-separated subset of depth,fuse,mesh.
+  std::string stages = "depth,fuse,mesh";
+  void Check() const;
+  bool HasStage(const std::string& stage) const;
+};
+
+struct ReconstructConfig {
+  RunOptions run;
+  ImageOptions image;
+  // Runs every struct's Check() (errors name section.key and the value).
+  void Check() const;
+};
+
+// Binds every field of `config` to its section.key in `set`.
+void RegisterOptions(ReconstructConfig* config, OptionSet* set);
+
+}  // namespace cli
+}  // namespace wild_mvs
