@@ -107,16 +107,39 @@ Eigen::Vector3d BaseColor(int seed) {
   return c;
 }
 
-// Linear albedo in [0.05, 1] per channel, fixed to the surface.
-Eigen::Vector3d Albedo(const SyntheticObject& o, const Eigen::Vector3d& p) {
+// Value noise with two independent channels from one lattice hash (low
+// and high 16 bits), for the colour variation.
+Eigen::Vector2d ValueNoise2(const Eigen::Vector3d& p, uint32_t seed) {
+  const double fx = std::floor(p.x()), fy = std::floor(p.y()),
+               fz = std::floor(p.z());
+  const int32_t x = static_cast<int32_t>(fx), y = static_cast<int32_t>(fy),
+                z = static_cast<int32_t>(fz);
+  const double u = Smooth(p.x() - fx), v = Smooth(p.y() - fy),
+               w = Smooth(p.z() - fz);
+  Eigen::Vector2d c[2][2];
+  for (int dz = 0; dz < 2; ++dz) {
+    for (int dy = 0; dy < 2; ++dy) {
+      const uint32_t ha = Hash(x, y + dy, z + dz, seed);
+      const uint32_t hb = Hash(x + 1, y + dy, z + dz, seed);
+      const Eigen::Vector2d a((ha & 0xFFFFu) / 65535.0, (ha >> 16) / 65535.0);
+      const Eigen::Vector2d b((hb & 0xFFFFu) / 65535.0, (hb >> 16) / 65535.0);
+      c[dz][dy] = a + (b - a) * u;
+    }
+  }
+  const Eigen::Vector2d c0 = c[0][0] + (c[0][1] - c[0][0]) * v;
+  const Eigen::Vector2d c1 = c[1][0] + (c[1][1] - c[1][0]) * v;
+  return c0 + (c1 - c0) * w;
+}
+
+// Linear albedo in [0.05, 1] per channel, fixed to the surface. `base` is
+// BaseColor(o.texture_seed).
+Eigen::Vector3d Albedo(const SyntheticObject& o, const Eigen::Vector3d& base,
+                       const Eigen::Vector3d& p) {
   const uint32_t seed = static_cast<uint32_t>(o.texture_seed) * 7919u + 1u;
   const double lum = Fbm(p, o.texture_scale, seed);
-  const double c1 = ValueNoise(
+  const Eigen::Vector2d ch = ValueNoise2(
       p * (1.0 / o.texture_scale) + Eigen::Vector3d(3.3, 1.7, 9.1), seed + 77u);
-  const double c2 =
-      ValueNoise(p * (1.0 / o.texture_scale) + Eigen::Vector3d(8.1, 2.9, 4.4),
-                 seed + 131u);
-  const Eigen::Vector3d base = BaseColor(o.texture_seed);
+  const double c1 = ch.x(), c2 = ch.y();
   Eigen::Vector3d tint(1.0 + 0.5 * (c1 - 0.5), 1.0 - 0.25 * (c1 + c2 - 1.0),
                        1.0 + 0.5 * (c2 - 0.5));
   Eigen::Vector3d a = (0.06 + 0.94 * lum) * base.cwiseProduct(tint);
@@ -126,13 +149,6 @@ Eigen::Vector3d Albedo(const SyntheticObject& o, const Eigen::Vector3d& p) {
 const Eigen::Vector3d& LightDir() {
   static const Eigen::Vector3d l = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
   return l;
-}
-
-// Linear radiance of a surface point (view independent).
-Eigen::Vector3d Radiance(const SyntheticObject& o, const Eigen::Vector3d& p,
-                         const Eigen::Vector3d& n) {
-  const double shade = 0.75 + 0.25 * std::abs(n.dot(LightDir()));
-  return 0.4 * shade * Albedo(o, p);
 }
 
 // ------------------------------------------------------------ intersection
@@ -147,7 +163,15 @@ struct Hit {
 struct Prepared {
   SyntheticObject obj;
   Eigen::Vector3d n{0, 0, 1};
+  Eigen::Vector3d base{1, 1, 1};  // BaseColor(obj.texture_seed)
 };
+
+// Linear radiance of a surface point (view independent).
+Eigen::Vector3d Radiance(const Prepared& o, const Eigen::Vector3d& p,
+                         const Eigen::Vector3d& n) {
+  const double shade = 0.75 + 0.25 * std::abs(n.dot(LightDir()));
+  return 0.4 * shade * Albedo(o.obj, o.base, p);
+}
 
 void IntersectObject(const Prepared& pr, int index, const Eigen::Vector3d& o,
                      const Eigen::Vector3d& d, Hit* hit) {
@@ -240,6 +264,7 @@ std::vector<Prepared> Prepare(const std::vector<SyntheticObject>& objects) {
             what, ": size must be positive");
     Prepared p;
     p.obj = o;
+    p.base = BaseColor(o.texture_seed);
     if (o.type == SyntheticObject::Type::kPlane) {
       Require(o.axis_u.norm() > 0 && o.axis_v.norm() > 0 &&
                   o.axis_u.cross(o.axis_v).norm() > 1e-9,
@@ -422,7 +447,7 @@ SyntheticScene Render(const SyntheticSpec& spec) {
             const Eigen::Vector3d d = RayDir(cam, u, v);
             const Hit s = Cast(objs, i, C, d);
             if (s.object < 0) continue;
-            L += Radiance(objs[s.object].obj, C + s.z * d, s.normal);
+            L += Radiance(objs[s.object], C + s.z * d, s.normal);
           }
         }
         L /= ss * ss;
@@ -491,7 +516,7 @@ SyntheticScene Render(const SyntheticSpec& spec) {
     }
     if (sp.track.size() < 2) continue;
     Eigen::Vector3d nn = h.normal;
-    const Eigen::Vector3d a = Radiance(objs[h.object].obj, X, nn);
+    const Eigen::Vector3d a = Radiance(objs[h.object], X, nn);
     sp.rgb = a.cast<float>();
     out.scene.points.push_back(sp);
   }
@@ -571,7 +596,8 @@ SyntheticSpec SlantedPlaneSpec(double slant_deg, int n) {
   return s;
 }
 
-SyntheticSpec ClutteredSceneSpec(bool vary_lighting, bool occluder) {
+SyntheticSpec ClutteredSceneSpec(bool vary_lighting, bool occluder,
+                                 double arc_deg) {
   SyntheticSpec s;
   using T = SyntheticObject::Type;
   SyntheticObject ground;
@@ -612,7 +638,7 @@ SyntheticSpec ClutteredSceneSpec(bool vary_lighting, bool occluder) {
   sphere.texture_scale = 0.05;
   s.objects.push_back(sphere);
 
-  s.camera_centers = MakeRingCameras(8, 2.6, 1.5);
+  s.camera_centers = MakeRingCameras(8, 2.6, 1.5, arc_deg);
   s.look_at = Eigen::Vector3d(0, 0, 0.15);
 
   if (occluder) {

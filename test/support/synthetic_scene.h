@@ -108,10 +108,16 @@ std::vector<Eigen::Vector3d> MakeRingCameras(int n, double radius,
 // A textured plane at depth ~2 slanted by `slant_deg` about the vertical
 // axis, seen by `n` cameras on a short arc in front of it.
 SyntheticSpec SlantedPlaneSpec(double slant_deg = 30, int n = 5);
-// Boxes and a sphere on a ground plane, 8 ring cameras, with per-view
-// exposure / white-balance / gamma changes when `vary_lighting`, and an
-// occluder present in view 0 only when `occluder`.
-SyntheticSpec ClutteredSceneSpec(bool vary_lighting, bool occluder);
+// Boxes and a sphere on a ground plane (4.4 x 4.4), 8 ring cameras at radius
+// 2.6, height 1.5 looking at (0, 0, 0.15), with per-view exposure (0.4 ..
+// 2.5) / white-balance (+-30 %) / gamma (1 .. 2.2) changes when
+// `vary_lighting`, and a textured box occluder present in view 0 only when
+// `occluder`. With the default full ring (arc_deg = 360) neighbouring views
+// are 45 degrees apart: wide baselines (unwarped 5x5 windows do not match on
+// the slanted ground). arc_deg < 360 puts the 8 cameras on an arc of that
+// many degrees instead (e.g. 105: 15 degrees apart) for stereo tests.
+SyntheticSpec ClutteredSceneSpec(bool vary_lighting, bool occluder,
+                                 double arc_deg = 360);
 
 // Writes the scene as a dataset folder that the CLI reads: COLMAP text model
 // in DIR/sparse/ (cameras.txt, images.txt, points3D.txt), 8-bit sRGB PNG
