@@ -535,15 +535,25 @@ ImageCache::Loader SyntheticScene::Loader() const {
 PointCloud SyntheticScene::GroundTruthCloud(int stride) const {
   Require(stride >= 1, "GroundTruthCloud: stride = ", stride, " must be >= 1");
   PointCloud cloud;
+  Require(depth.size() == scene.views.size() &&
+              normals.size() == depth.size() && images.size() == depth.size() &&
+              object_id.size() == depth.size(),
+          "GroundTruthCloud: the scene's per-view maps are inconsistent");
   for (size_t i = 0; i < depth.size(); ++i) {
     const Camera& cam = scene.views[i].camera;
     const Eigen::Matrix3d Rt = cam.R.transpose();
+    Require(depth[i].type() == CV_32F && normals[i].size() == depth[i].size() &&
+                images[i].size() == depth[i].size() &&
+                object_id[i].size() == depth[i].size(),
+            "GroundTruthCloud: view ", i, " maps differ in size or type");
     for (int r = 0; r < depth[i].rows; r += stride) {
       for (int c = 0; c < depth[i].cols; c += stride) {
         const float z = depth[i].at<float>(r, c);
         if (!(z > 0)) continue;
         const int id = object_id[i].at<int>(r, c);
-        if (id < 0 || spec.objects[id].only_in_view >= 0) continue;
+        if (id < 0 || id >= static_cast<int>(spec.objects.size()) ||
+            spec.objects[id].only_in_view >= 0)
+          continue;
         const Eigen::Vector3d X = cam.Backproject({c + 0.5, r + 0.5}, z);
         const cv::Vec3f nc = normals[i].at<cv::Vec3f>(r, c);
         const Eigen::Vector3d nw = Rt * Eigen::Vector3d(nc[0], nc[1], nc[2]);

@@ -148,6 +148,57 @@ TEST(DepthMetrics, GroundTruthIsResampledToTheEstimateCamera) {
   EXPECT_THROW(ResampleDepth(a.depth[0], ca, a.scene.views[0].camera), Error);
 }
 
+// Exact depth map of the plane n . X = d seen by `cam` (0 where the plane
+// is behind the camera).
+cv::Mat PlaneDepth(const Camera& cam, const Eigen::Vector3d& n, double d) {
+  cv::Mat out(cam.height, cam.width, CV_32F, cv::Scalar(0));
+  for (int r = 0; r < cam.height; ++r)
+    for (int c = 0; c < cam.width; ++c) {
+      const Eigen::Vector3d ray =
+          cam.R.transpose() * cam.BackprojectCam({c + 0.5, r + 0.5}, 1.0);
+      const double z = (d - n.dot(cam.Center())) / n.dot(ray);
+      if (z > 0) out.at<float>(r, c) = static_cast<float>(z);
+    }
+  return out;
+}
+
+TEST(DepthMetrics, PrincipalPointMappingLikeFountainP11) {
+  // fountain-P11's ground truth was rendered with a centred principal point
+  // and square pixels while the real camera has cx, cy off-centre and
+  // fx != fy (STAGING_NOTES.txt), at 1/16 of the resolution here.
+  Camera real;
+  real.width = 192;
+  real.height = 128;
+  real.fx = 2759.48 / 16;
+  real.fy = 2764.16 / 16;
+  real.cx = 1520.69 / 16 + 0.5;
+  real.cy = 1006.81 / 16 + 0.5;
+  real.R = Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, 1, 0.1).normalized())
+               .toRotationMatrix();
+  real.t = Eigen::Vector3d(0.3, -0.1, 1.0);
+  Camera render = real;
+  render.fx = render.fy = 2759.48 / 16;
+  render.cx = 1536.0 / 16 + 0.5;
+  render.cy = 1024.0 / 16 + 0.5;
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.3, 1).normalized();
+  const double d = n.dot(real.CameraToWorld({0, 0, 8.0}));
+  const cv::Mat gt_render = PlaneDepth(render, n, d);
+  const cv::Mat gt_real = PlaneDepth(real, n, d);
+  // Mapped: agrees with the real camera's depth wherever it is defined.
+  const cv::Mat mapped = ResampleDepth(gt_render, render, real);
+  const DepthMetrics ok = EvaluateDepth(mapped, gt_real);
+  EXPECT_GT(ok.completeness, 0.95);  // a border strip maps outside
+  EXPECT_LT(ok.median_rel_error, 1e-5);
+  EXPECT_DOUBLE_EQ(ok.relative_accuracy[0], 1.0);
+  // Through the camera overload as well: same numbers.
+  const DepthMetrics ok2 = EvaluateDepth(gt_real, real, gt_render, render);
+  EXPECT_EQ(ok2.evaluated, ok.evaluated);
+  EXPECT_LT(ok2.median_rel_error, 1e-5);
+  // Unmapped (taking the rendered GT pixel for pixel) is measurably wrong.
+  const DepthMetrics bad = EvaluateDepth(gt_render, gt_real);
+  EXPECT_GT(bad.median_rel_error, 100 * ok.median_rel_error + 1e-4);
+}
+
 // ------------------------------------------------------------ clouds
 
 // Points on the plane z = 0, a regular grid of n x n with spacing h.
