@@ -62,6 +62,10 @@ int DescriptorDistanceSquared(const uint8_t* a, const uint8_t* b) {
 
 namespace {
 
+// OpenCV keypoint coordinate -> camera.h coordinate: +0.5 for the pixel
+// centre convention, -0.25 for the SIFT upsampling bias (see below).
+constexpr double kOpenCvToPixel = 0.5 - 0.25;
+
 // Display-encoded 8-bit grey image for detection.
 cv::Mat ToGrey8(const cv::Mat& image, bool srgb_encode) {
   if (image.type() == CV_8UC1) return image;
@@ -151,10 +155,15 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
   const bool colour = image.type() == CV_32FC3;
   for (int i = 0; i < n; ++i) {
     const cv::KeyPoint& kp = kps[order[i]];
-    // OpenCV: pixel centre at integer coordinates -> +0.5 (camera.h); then
-    // scale edge-based coordinates to full resolution.
-    const float x = static_cast<float>((kp.pt.x + 0.5) * s);
-    const float y = static_cast<float>((kp.pt.y + 0.5) * sy);
+    // OpenCV puts pixel centres at integer coordinates -> +0.5 (camera.h).
+    // OpenCV 4.6's SIFT also reports every keypoint 0.25 px too far right and
+    // down: it doubles the image with a centre-aligned linear resize and
+    // maps octave coordinates back by plain scaling (opencv/opencv#23123,
+    // fixed by `enable_precise_upscale` only in 4.8). Both are compensated
+    // (kOpenCvToPixel), measured on synthetic blobs in the tests. Then the
+    // edge-based coordinates are scaled to full resolution.
+    const float x = static_cast<float>((kp.pt.x + kOpenCvToPixel) * s);
+    const float y = static_cast<float>((kp.pt.y + kOpenCvToPixel) * sy);
     f.xy.emplace_back(x, y);
     f.scale.push_back(static_cast<float>(kp.size * 0.5 * (s + sy)));
     // Colour at the nearest full-resolution pixel.

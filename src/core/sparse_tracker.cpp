@@ -46,6 +46,9 @@ void TrackerOptions::Check() const {
           " must be in [0, 90)");
   Require(min_track_length >= 2,
           "tracker.min_track_length = ", min_track_length, " must be >= 2");
+  Require(max_scale_ratio == 0 || max_scale_ratio >= 1,
+          "tracker.max_scale_ratio = ", max_scale_ratio,
+          " must be 0 (off) or >= 1");
   Require(refine_iterations >= 0,
           "tracker.refine_iterations = ", refine_iterations, " must be >= 0");
 }
@@ -53,6 +56,9 @@ void TrackerOptions::Check() const {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
+// SIFT reports one keypoint per dominant orientation: features of one view
+// closer than this (pixels) are the same point.
+constexpr float kTwinDistance = 1.0f;
 
 struct ViewData {
   int id = -1;
@@ -95,12 +101,14 @@ std::vector<Match> MatchPair(const ViewData& a, const ViewData& b,
     const float n = l.head<2>().norm();
     lines_in_a[j] = n > 0 ? Eigen::Vector3f(l / n) : Eigen::Vector3f::Zero();
   }
-  constexpr int kNone = -1;
-  const int kInf = std::numeric_limits<int>::max();
-  std::vector<int> best_a(na, kNone), d1_a(na, kInf), d2_a(na, kInf);
-  std::vector<int> best_b(nb, kNone), d1_b(nb, kInf), d2_b(nb, kInf);
-  std::vector<int> cand;
-  cand.reserve(256);
+  // Epipolar-compatible candidates (both directions) with their squared
+  // descriptor distances.
+  struct Cand {
+    int i, j, d;
+  };
+  std::vector<Cand> cands;
+  std::vector<int> band;
+  band.reserve(256);
   for (int i = 0; i < na; ++i) {
     const Eigen::Vector2f& p = fa.xy[i];
     Eigen::Vector3f l = F * Eigen::Vector3f(p.x(), p.y(), 1.0f);
@@ -108,43 +116,55 @@ std::vector<Match> MatchPair(const ViewData& a, const ViewData& b,
     if (!(n > 0)) continue;
     l /= n;
     const float la = l.x(), lb = l.y(), lc = l.z();
-    cand.clear();
+    band.clear();
     for (int j = 0; j < nb; ++j) {
-      if (std::abs(la * bx[j] + lb * by[j] + lc) <= thr) cand.push_back(j);
+      if (std::abs(la * bx[j] + lb * by[j] + lc) <= thr) band.push_back(j);
     }
     const uint8_t* da = fa.descriptors.ptr<uint8_t>(i);
-    for (int j : cand) {
+    for (int j : band) {
       const Eigen::Vector3f& m = lines_in_a[j];
       if (!(std::abs(m.x() * p.x() + m.y() * p.y() + m.z()) <= thr)) continue;
-      const int d =
-          DescriptorDistanceSquared(da, fb.descriptors.ptr<uint8_t>(j));
-      if (d < d1_a[i]) {
-        d2_a[i] = d1_a[i];
-        d1_a[i] = d;
-        best_a[i] = j;
-      } else if (d < d2_a[i]) {
-        d2_a[i] = d;
-      }
-      if (d < d1_b[j]) {
-        d2_b[j] = d1_b[j];
-        d1_b[j] = d;
-        best_b[j] = i;
-      } else if (d < d2_b[j]) {
-        d2_b[j] = d;
-      }
+      cands.push_back(
+          {i, j,
+           DescriptorDistanceSquared(da, fb.descriptors.ptr<uint8_t>(j))});
+    }
+  }
+  // Best and second-best per feature. SIFT reports one keypoint per dominant
+  // orientation, so a feature may appear twice at the same position: such a
+  // twin of the best candidate is the same physical point and must not fail
+  // the ratio test, so the second best is taken among candidates more than
+  // kTwinDistance pixels from the best.
+  const int kInf = std::numeric_limits<int>::max();
+  struct Best {
+    int idx = -1, d1 = std::numeric_limits<int>::max(),
+        d2 = std::numeric_limits<int>::max();
+  };
+  std::vector<Best> best_a(na), best_b(nb);
+  for (const Cand& c : cands) {
+    if (c.d < best_a[c.i].d1) best_a[c.i].d1 = c.d, best_a[c.i].idx = c.j;
+    if (c.d < best_b[c.j].d1) best_b[c.j].d1 = c.d, best_b[c.j].idx = c.i;
+  }
+  for (const Cand& c : cands) {
+    Best& ba = best_a[c.i];
+    if (c.j != ba.idx && (fb.xy[c.j] - fb.xy[ba.idx]).norm() > kTwinDistance) {
+      ba.d2 = std::min(ba.d2, c.d);
+    }
+    Best& bb = best_b[c.j];
+    if (c.i != bb.idx && (fa.xy[c.i] - fa.xy[bb.idx]).norm() > kTwinDistance) {
+      bb.d2 = std::min(bb.d2, c.d);
     }
   }
   const double max_d = opt.max_descriptor_distance * Features::kDescriptorScale;
   const double max_d2 = max_d * max_d;
   const double r2 = opt.ratio * opt.ratio;
-  auto passes = [&](int d1, int d2) {
-    if (d1 > max_d2) return false;
-    return d2 == kInf || static_cast<double>(d1) < r2 * d2;
+  auto passes = [&](const Best& b) {
+    if (b.idx < 0 || b.d1 > max_d2) return false;
+    return b.d2 == kInf || static_cast<double>(b.d1) < r2 * b.d2;
   };
   for (int i = 0; i < na; ++i) {
-    const int j = best_a[i];
-    if (j == kNone || !passes(d1_a[i], d2_a[i])) continue;
-    if (opt.mutual && (best_b[j] != i || !passes(d1_b[j], d2_b[j]))) continue;
+    const int j = best_a[i].idx;
+    if (!passes(best_a[i])) continue;
+    if (opt.mutual && (best_b[j].idx != i || !passes(best_b[j]))) continue;
     out.emplace_back(i, j);
   }
   return out;
@@ -313,11 +333,24 @@ struct SparseTracker::Impl {
     }
     PointData pd;
     std::vector<int> nodes;
-    std::set<int> seen_slots;
-    for (int n : mit->second) {
+    std::map<int, int> node_of_slot;
+    std::vector<int> sorted = mit->second;
+    std::sort(sorted.begin(), sorted.end());  // deterministic twin choice
+    for (int n : sorted) {
       const int s = node_slot[n];
-      if (views[s].removed) continue;
-      if (!seen_slots.insert(s).second) pd.conflict = true;
+      const ViewData& v = views[s];
+      if (v.removed) continue;
+      auto it = node_of_slot.find(s);
+      if (it != node_of_slot.end()) {
+        // Two features of one view: SIFT orientation twins (same position)
+        // are one point; otherwise the track is inconsistent.
+        if ((v.features.xy[n - v.offset] - v.features.xy[it->second - v.offset])
+                .norm() > kTwinDistance) {
+          pd.conflict = true;
+        }
+        continue;
+      }
+      node_of_slot[s] = n;
       nodes.push_back(n);
     }
     if (pd.conflict || static_cast<int>(nodes.size()) < opt.min_track_length) {
@@ -356,6 +389,20 @@ struct SparseTracker::Impl {
       for (const TriangulationInput& o : obs) {
         if (!(o.camera->Depth(X) > 0)) ok = false;
       }
+    }
+    if (ok && opt.max_scale_ratio > 0) {
+      // The feature's size in the world (SIFT scale x pixel footprint at its
+      // depth) must agree between the views: a false match along the
+      // epipolar line usually pairs blobs of different sizes.
+      double lo = std::numeric_limits<double>::infinity(), hi = 0;
+      for (size_t k = 0; k < nodes.size(); ++k) {
+        const ViewData& v = views[node_slot[nodes[k]]];
+        const double sc = v.features.scale[nodes[k] - v.offset];
+        const double w = sc * v.camera.PixelFootprint(v.camera.Depth(X));
+        lo = std::min(lo, w);
+        hi = std::max(hi, w);
+      }
+      if (lo > 0 && hi > opt.max_scale_ratio * lo) ok = false;
     }
     if (ok && MaxTriangulationAngle(obs, X) <
                   opt.min_triangulation_angle_deg * kDeg) {

@@ -2,10 +2,11 @@
 //
 // Keypoint positions are in the pixel convention of camera.h (the top-left
 // pixel's centre is (0.5, 0.5)): OpenCV puts pixel centres at integer
-// coordinates, so 0.5 is added, and positions found on a downscaled image are
-// mapped back to the full-resolution view. The scale is the SIFT keypoint
-// size (diameter of the meaningful neighbourhood) in full-resolution pixels;
-// global view selection uses it as the feature scale.
+// coordinates, so 0.5 is added, minus the 0.25 px bias of OpenCV 4.6's SIFT
+// (opencv/opencv#23123; checked on synthetic blobs), and positions found on a
+// downscaled image are mapped back to the full-resolution view. The scale is
+// the SIFT keypoint size (diameter of the meaningful neighbourhood) in
+// full-resolution pixels; global view selection uses it as the feature scale.
 #pragma once
 
 #include <Eigen/Core>
