@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -15,45 +13,15 @@
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/core/thread_pool.h"
 #include "wild_mvs/core/triangulation.h"
+#include "wild_mvs/io/middlebury.h"
 
 namespace wild_mvs {
 namespace {
 
-// Minimal reading of a Middlebury *_par.txt (the io layer has the full,
-// validating reader; this test only needs the cameras).
-Scene LoadPar(const std::string& dir, const std::string& par) {
-  std::ifstream in(dir + "/" + par);
-  Scene scene;
-  int n = 0;
-  in >> n;
-  for (int i = 0; i < n; ++i) {
-    View v;
-    double k[9], r[9], t[3];
-    in >> v.name;
-    for (double& x : k) in >> x;
-    for (double& x : r) in >> x;
-    for (double& x : t) in >> x;
-    v.image_path = dir + "/" + v.name;
-    Camera& c = v.camera;
-    c.fx = k[0];
-    c.fy = k[4];
-    c.cx = k[2] + 0.5;  // Middlebury: integer pixel centres
-    c.cy = k[5] + 0.5;
-    c.width = 640;
-    c.height = 480;
-    Eigen::Matrix3d R;
-    R << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
-    c.R = NearestRotation(R);
-    c.t = Eigen::Vector3d(t[0], t[1], t[2]);
-    scene.views.push_back(v);
-  }
-  EXPECT_TRUE(in.good());
-  return scene;
-}
-
 TEST(SparseTrackerReal, TempleSparseRing) {
   WILD_MVS_REQUIRE_SHARED(dir, "datasets/middlebury_templeSparseRing");
-  Scene scene = LoadPar(dir, "templeSR_par.txt");
+  // The cameras only (the par format has no points).
+  Scene scene = ReadMiddleburyPar(dir + "/templeSR_par.txt");
   ASSERT_EQ(scene.views.size(), 16u);
   ImageOptions io;
   ImageCache cache(MakeSceneLoader(scene, io), 256);
