@@ -1,0 +1,62 @@
+# libFuzzer harnesses for every reader (included when -DWILD_MVS_FUZZ=ON).
+#
+# Configure with clang (scripts/run_fuzz.sh does it in build-fuzz/):
+#   cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DWILD_MVS_FUZZ=ON \
+#         -DWILD_MVS_WITH_ROS=OFF
+# Every target of the project is then built with AddressSanitizer and
+# UndefinedBehaviorSanitizer (so tests and tools still link), the library
+# code with libFuzzer's coverage instrumentation, and each
+# test/fuzz/fuzz_<name>.cpp becomes an executable fuzz_<name> (a libFuzzer
+# binary; run it with a corpus folder, see scripts/run_fuzz.sh). The target
+# `fuzzers` builds all harnesses.
+if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+  message(FATAL_ERROR "WILD_MVS_FUZZ=ON needs clang "
+          "(-DCMAKE_CXX_COMPILER=clang++); got ${CMAKE_CXX_COMPILER_ID}")
+endif()
+
+set(WILD_MVS_FUZZ_SANITIZERS -fsanitize=address,undefined
+    -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+
+# Sanitize everything already defined (libraries, tool, tests, benchmarks).
+get_property(_wild_mvs_targets DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}
+             PROPERTY BUILDSYSTEM_TARGETS)
+foreach(t ${_wild_mvs_targets})
+  get_target_property(_type ${t} TYPE)
+  if(_type MATCHES "^(STATIC_LIBRARY|SHARED_LIBRARY|OBJECT_LIBRARY|EXECUTABLE)$")
+    target_compile_options(${t} PRIVATE ${WILD_MVS_FUZZ_SANITIZERS})
+    target_link_options(${t} PRIVATE -fsanitize=address,undefined)
+  endif()
+endforeach()
+# Coverage feedback for the code under test.
+foreach(lib wild_mvs_core wild_mvs_io)
+  target_compile_options(${lib} PRIVATE -fsanitize=fuzzer-no-link)
+endforeach()
+
+# Sources of the command-line tool that a harness needs (the YAML config
+# loader lives in src/cli/, which has no library of its own).
+set(WILD_MVS_FUZZ_CLI_SRC)
+foreach(f option_set.cpp options.cpp)
+  if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/${f})
+    list(APPEND WILD_MVS_FUZZ_CLI_SRC ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/${f})
+  endif()
+endforeach()
+
+add_custom_target(fuzzers)
+file(GLOB WILD_MVS_FUZZ_HARNESSES CONFIGURE_DEPENDS test/fuzz/fuzz_*.cpp)
+foreach(src ${WILD_MVS_FUZZ_HARNESSES})
+  get_filename_component(name ${src} NAME_WE)
+  set(extra)
+  if(name STREQUAL "fuzz_yaml_config")
+    set(extra ${WILD_MVS_FUZZ_CLI_SRC})
+  endif()
+  add_executable(${name} ${src} ${extra})
+  target_include_directories(${name} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/test/fuzz
+                             ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_compile_options(${name} PRIVATE -fsanitize=fuzzer
+                         ${WILD_MVS_FUZZ_SANITIZERS} ${WILD_MVS_WARNINGS})
+  target_link_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
+  target_link_libraries(${name} PRIVATE wild_mvs_io yaml-cpp)
+  set_target_properties(${name} PROPERTIES
+    RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
+  add_dependencies(fuzzers ${name})
+endforeach()
