@@ -7,8 +7,10 @@
 # UndefinedBehaviorSanitizer (so tests and tools still link), the library
 # code with libFuzzer's coverage instrumentation, and each
 # test/fuzz/fuzz_<name>.cpp becomes an executable fuzz_<name> (a libFuzzer
-# binary; run it with a corpus folder, see scripts/run_fuzz.sh). The target
-# `fuzzers` builds all harnesses.
+# binary; run it with a corpus folder, see scripts/run_fuzz.sh). With
+# WILD_MVS_WITH_ROS=ON, test/fuzz/ros/fuzz_ros_messages.cpp (the nodes'
+# message decoding, src/ros/conversions.cpp) is built too. The target
+# `fuzzers` builds all harnesses into ${CMAKE_BINARY_DIR}/fuzz/.
 if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
   message(FATAL_ERROR "WILD_MVS_FUZZ=ON needs clang "
           "(-DCMAKE_CXX_COMPILER=clang++); got ${CMAKE_CXX_COMPILER_ID}")
@@ -32,22 +34,26 @@ foreach(lib wild_mvs_core wild_mvs_io)
   target_compile_options(${lib} PRIVATE -fsanitize=fuzzer-no-link)
 endforeach()
 
-# Sources of the command-line tool that a harness needs (the YAML config
-# loader lives in src/cli/, which has no library of its own).
-set(WILD_MVS_FUZZ_CLI_SRC)
-foreach(f option_set.cpp options.cpp)
-  if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/${f})
-    list(APPEND WILD_MVS_FUZZ_CLI_SRC ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/${f})
-  endif()
-endforeach()
+# Sources of the command-line tool for the YAML config harness (src/cli/ has
+# no library of its own): everything but main().
+file(GLOB WILD_MVS_FUZZ_CLI_SRC CONFIGURE_DEPENDS src/cli/*.cpp)
+list(REMOVE_ITEM WILD_MVS_FUZZ_CLI_SRC ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/main.cpp)
 
 add_custom_target(fuzzers)
 file(GLOB WILD_MVS_FUZZ_HARNESSES CONFIGURE_DEPENDS test/fuzz/fuzz_*.cpp)
+if(WILD_MVS_WITH_ROS AND TARGET ${PROJECT_NAME}_generate_messages_cpp)
+  list(APPEND WILD_MVS_FUZZ_HARNESSES
+       ${CMAKE_CURRENT_SOURCE_DIR}/test/fuzz/ros/fuzz_ros_messages.cpp)
+endif()
 foreach(src ${WILD_MVS_FUZZ_HARNESSES})
   get_filename_component(name ${src} NAME_WE)
   set(extra)
   if(name STREQUAL "fuzz_yaml_config")
     set(extra ${WILD_MVS_FUZZ_CLI_SRC})
+  elseif(name STREQUAL "fuzz_ros_messages")
+    # Compiled into the harness (with coverage) rather than linking the
+    # whole ROS layer library.
+    set(extra ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/conversions.cpp)
   endif()
   add_executable(${name} ${src} ${extra})
   target_include_directories(${name} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/test/fuzz
@@ -58,5 +64,12 @@ foreach(src ${WILD_MVS_FUZZ_HARNESSES})
   target_link_libraries(${name} PRIVATE wild_mvs_io yaml-cpp)
   set_target_properties(${name} PROPERTIES
     RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
+  if(name STREQUAL "fuzz_ros_messages")
+    target_include_directories(${name} PRIVATE
+      ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
+    target_include_directories(${name} SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+    target_link_libraries(${name} PRIVATE ${catkin_LIBRARIES})
+    add_dependencies(${name} ${PROJECT_NAME}_generate_messages_cpp)
+  endif()
   add_dependencies(fuzzers ${name})
 endforeach()

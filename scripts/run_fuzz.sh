@@ -4,7 +4,8 @@
 #
 # Usage: scripts/run_fuzz.sh [SECONDS] [HARNESS...]
 #   SECONDS   per harness (default 30; $FUZZ_SECONDS also works)
-#   HARNESS   names like fuzz_pfm (default: every test/fuzz/fuzz_*.cpp)
+#   HARNESS   names like fuzz_pfm (default: every harness built, i.e. each
+#             test/fuzz/fuzz_*.cpp, and test/fuzz/ros/ when ROS is found)
 # Environment: JOBS harnesses run in parallel (default: number of cores),
 #   FUZZ_BUILD_DIR (default build-fuzz).
 # Prints executions and findings per harness; exits non-zero when any
@@ -27,13 +28,20 @@ command -v clang++ >/dev/null || {
   echo "run_fuzz.sh: clang++ not found (scripts/install_deps.sh --extra)" >&2
   exit 2
 }
+# The ROS harness (message decoding of the nodes) is built when catkin is
+# installed; WILD_MVS_FUZZ_ROS=OFF skips it.
+ros="${WILD_MVS_FUZZ_ROS:-}"
+if [ -z "$ros" ]; then
+  ros=OFF
+  [ -f /usr/share/catkin/cmake/catkinConfig.cmake ] && ros=ON
+fi
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 mkdir -p "$FUZZ_BUILD_DIR"
 echo "run_fuzz.sh: building harnesses in $FUZZ_BUILD_DIR"
 cmake -S "$ROOT" -B "$FUZZ_BUILD_DIR" -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
-  -DWILD_MVS_FUZZ=ON -DWILD_MVS_WITH_ROS=OFF -DWILD_MVS_BUILD_TESTS=OFF \
+  -DWILD_MVS_FUZZ=ON -DWILD_MVS_WITH_ROS="$ros" -DWILD_MVS_BUILD_TESTS=OFF \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
   "${launcher[@]}" >"$FUZZ_BUILD_DIR.cmake.log" 2>&1 ||
   { cat "$FUZZ_BUILD_DIR.cmake.log"; exit 1; }
@@ -43,8 +51,8 @@ if [ $# -gt 0 ]; then
   harnesses=("$@")
 else
   harnesses=()
-  for f in "$ROOT"/test/fuzz/fuzz_*.cpp; do
-    [ -e "$f" ] && harnesses+=("$(basename "$f" .cpp)")
+  for f in "$FUZZ_BUILD_DIR"/fuzz/fuzz_*; do
+    [ -x "$f" ] && harnesses+=("$(basename "$f")")
   done
 fi
 [ ${#harnesses[@]} -gt 0 ] || { echo "run_fuzz.sh: no harnesses" >&2; exit 2; }

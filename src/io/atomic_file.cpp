@@ -69,6 +69,7 @@ void WriteFileAtomically(const std::string& path,
       const int err = errno;
       throw Error(Msg(path, ": cannot open for writing: ", std::strerror(err)));
     }
+    errno = 0;  // so a failure below reports its own cause, not a stale one
     try {
       write(out);
     } catch (...) {
@@ -99,6 +100,7 @@ void ProduceFileAtomically(
   PrepareParent(path);
   const std::string tmp = TempNameFor(path);
   bool ok = false;
+  errno = 0;  // a producer that fails without errno must not show a stale one
   try {
     ok = produce(tmp);
   } catch (...) {

@@ -258,6 +258,41 @@ def ply_seeds():
     put("ply", "ascii_xyz_double", xyz)
 
 
+def ros_seeds():
+    def image(h, w, enc, step, data, big=0):
+        return (struct.pack("<II", h, w) + bytes([len(enc)]) + enc.encode() +
+                struct.pack("<BII", big, step, len(data)) + data)
+
+    def info(h, w, model, D, K):
+        return (struct.pack("<II", h, w) + bytes([len(model)]) +
+                model.encode() + bytes([len(D)]) +
+                struct.pack("<%dd" % len(D), *D) + struct.pack("<9d", *K))
+
+    pose = struct.pack("<7d", 0.1, -0.2, 0.3, 0, 0, math.sin(0.1), math.cos(0.1))
+    w, h = 4, 3
+    depth = [1.0 + 0.1 * i for i in range(w * h)]
+    depth[5] = float("nan")
+    conf = [0.5] * (w * h)
+    normals = [0.0, 0.0, -1.0] * (w * h)
+    K = [100, 0, 1.5, 0, 100, 1.0, 0, 0, 1]
+    dv = (b"\0" + struct.pack("<I", 7) + bytes([2]) + struct.pack("<II", 3, 5) +
+          image(h, w, "32FC1", 4 * w, struct.pack("<%df" % len(depth), *depth)) +
+          image(h, w, "32FC1", 4 * w, struct.pack("<%df" % len(conf), *conf)) +
+          image(h, w, "32FC3", 12 * w,
+                struct.pack("<%df" % len(normals), *normals)) +
+          info(h, w, "plumb_bob", [0] * 5, K) + pose)
+    put("ros_messages", "depth_view", dv)
+    put("ros_messages", "image_rgb8",
+        b"\1" + image(2, 2, "rgb8", 6, bytes(range(12))) + b"\1")
+    put("ros_messages", "image_mono16",
+        b"\1" + image(2, 3, "mono16", 6, bytes(range(12))) + b"\0")
+    put("ros_messages", "image_bgra8_padded",
+        b"\1" + image(2, 2, "bgra8", 10, bytes(range(20))) + b"\1")
+    put("ros_messages", "camera_info",
+        b"\2" + info(480, 640, "plumb_bob", [-0.1, 0.01, 0.001, 0, 0],
+                      [500, 0, 319.5, 0, 505, 239.5, 0, 0, 1]) + pose)
+
+
 if __name__ == "__main__":
     colmap_seeds()
     par_seeds()
@@ -265,6 +300,7 @@ if __name__ == "__main__":
     bundler_seeds()
     pfm_seeds()
     ply_seeds()
+    ros_seeds()
     for h in sorted(os.listdir(CORPUS)):
         files = os.listdir(os.path.join(CORPUS, h))
         size = sum(os.path.getsize(os.path.join(CORPUS, h, f)) for f in files)
