@@ -13,6 +13,7 @@
 #include <filesystem>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/metrics.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/pfm.h"
 
@@ -118,50 +119,6 @@ cv::Mat ReadGroundTruthDepth(const std::string& path) {
   throw Error(Msg(path,
                   ": unknown ground-truth depth format (expected .pfm "
                   "or .exr)"));
-}
-
-cv::Mat ResampleDepth(const cv::Mat& depth, const Camera& src,
-                      const Camera& dst) {
-  Require(depth.type() == CV_32F && !depth.empty(),
-          "ResampleDepth: depth must be a non-empty CV_32F image");
-  Require(depth.cols == src.width && depth.rows == src.height,
-          "ResampleDepth: depth is ", depth.cols, "x", depth.rows,
-          " but its camera is ", src.width, "x", src.height);
-  Require((src.R - dst.R).norm() < 1e-9 &&
-              (src.t - dst.t).norm() < 1e-9 * (1 + src.t.norm()),
-          "ResampleDepth: the cameras must have the same pose");
-  cv::Mat out(dst.height, dst.width, CV_32F, cv::Scalar(0));
-  const int W = depth.cols, H = depth.rows;
-  for (int r = 0; r < dst.height; ++r) {
-    float* o = out.ptr<float>(r);
-    const double y = (r + 0.5 - dst.cy) / dst.fy;
-    const double fr = src.fy * y + src.cy - 0.5;  // source row (centres)
-    for (int c = 0; c < dst.width; ++c) {
-      const double x = (c + 0.5 - dst.cx) / dst.fx;
-      const double fc = src.fx * x + src.cx - 0.5;
-      if (fc < -0.5 || fr < -0.5 || fc > W - 0.5 || fr > H - 0.5) continue;
-      const int c0 = static_cast<int>(std::floor(fc));
-      const int r0 = static_cast<int>(std::floor(fr));
-      const double ax = fc - c0, ay = fr - r0;
-      auto at = [&](int rr, int cc) {
-        rr = std::clamp(rr, 0, H - 1);
-        cc = std::clamp(cc, 0, W - 1);
-        return depth.at<float>(rr, cc);
-      };
-      const float d00 = at(r0, c0), d01 = at(r0, c0 + 1), d10 = at(r0 + 1, c0),
-                  d11 = at(r0 + 1, c0 + 1);
-      const float lo = std::min({d00, d01, d10, d11});
-      const float hi = std::max({d00, d01, d10, d11});
-      if (lo > 0 && hi - lo <= 0.01f * lo) {
-        o[c] = static_cast<float>((1 - ay) * ((1 - ax) * d00 + ax * d01) +
-                                  ay * ((1 - ax) * d10 + ax * d11));
-      } else {
-        o[c] = at(static_cast<int>(std::lround(fr)),
-                  static_cast<int>(std::lround(fc)));
-      }
-    }
-  }
-  return out;
 }
 
 Camera FountainRenderCamera(const Camera& real) {

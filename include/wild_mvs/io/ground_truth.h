@@ -20,6 +20,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "wild_mvs/core/metrics.h"
 #include "wild_mvs/core/scene.h"
 
 namespace wild_mvs {
@@ -33,13 +34,9 @@ void WriteExrDepth(const std::string& path, const cv::Mat& depth);
 // .pfm or .exr by extension (case-insensitive); invalid values -> 0.
 cv::Mat ReadGroundTruthDepth(const std::string& path);
 
-// Resamples depth seen by camera `src` into the pixel grid of camera `dst`,
-// which must have the same pose (R, t): only the intrinsics and size differ,
-// so z is unchanged. Bilinear where the 4 neighbours are valid and within
-// 1 % of each other, else nearest (no mixing across depth edges); 0 outside
-// or where the source is invalid. Throws Error if the poses differ.
-cv::Mat ResampleDepth(const cv::Mat& depth, const Camera& src,
-                      const Camera& dst);
+// Resampling between cameras of the same pose: ResampleDepth in
+// wild_mvs/core/metrics.h (bilinear in inverse depth where the 4 neighbours
+// agree within 1 %, nearest otherwise: no mixing across depth edges).
 
 // The render camera of the fountain-P11 GT depth for a real camera (its
 // pose), at the render's full size 3072x2048.
