@@ -368,6 +368,27 @@ TEST(SparseTracker, EpipolarGateRejectsWrongPose) {
   EXPECT_LT(bad.Stats().matches, 0.3 * good.Stats().matches);
 }
 
+// Matches whose features differ in world size (SIFT scale x pixel
+// footprint) by more than max_scale_ratio are rejected.
+TEST(SparseTracker, ScaleConsistencyFilter) {
+  FeatureWorld w = MakeWorld(2, 20, 400, 0.0, 12);
+  auto count = [&w](double factor, double max_ratio) {
+    Features f1 = w.features[1];
+    for (float& s : f1.scale) s *= static_cast<float>(factor);
+    TrackerOptions opt;
+    opt.max_scale_ratio = max_ratio;
+    SparseTracker t(opt);
+    t.AddView(0, w.cameras[0], w.features[0]);
+    t.AddView(1, w.cameras[1], f1);
+    return t.Points().size();
+  };
+  const size_t base = count(1.0, 1.8);
+  EXPECT_GT(base, 200u);
+  EXPECT_NEAR(static_cast<double>(count(1.3, 1.8)), base, 0.1 * base);
+  EXPECT_EQ(count(2.5, 1.8), 0u);
+  EXPECT_EQ(count(2.5, 0), base);  // filter off
+}
+
 TEST(SparseTracker, FillSceneChecksViewIndices) {
   const FeatureWorld w = MakeWorld(3, 30, 300, 0.0, 9);
   SparseTracker tracker(TrackerOptions{});
