@@ -18,10 +18,6 @@ int NotYet(const CommandSpec& spec, const CommandArgs& argv) {
   throw Error(Msg("this build does not implement '", spec.name, "' yet"));
 }
 }  // namespace
-int RunInfo(const CommandArgs& a) { return NotYet(InfoSpec(), a); }
-int RunSparse(const CommandArgs& a) { return NotYet(SparseSpec(), a); }
-int RunFuse(const CommandArgs& a) { return NotYet(FuseSpec(), a); }
-int RunMesh(const CommandArgs& a) { return NotYet(MeshSpec(), a); }
 int RunEval(const CommandArgs& a) { return NotYet(EvalSpec(), a); }
 }  // namespace cli
 }  // namespace wild_mvs

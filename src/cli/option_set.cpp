@@ -121,10 +121,20 @@ void OptionSet::Add(const std::string& name, int* field,
 }
 
 void OptionSet::Add(const std::string& name, double* field,
-                    const std::string& help, double lo, double hi) {
+                    const std::string& help, double lo, double hi,
+                    bool allow_infinite) {
   Entry e{name, "float", help, RangeText(lo, hi), nullptr, nullptr};
-  e.set = [field, lo, hi](const std::string& t) {
-    const double v = ParseDouble(t, "");
+  e.set = [field, lo, hi, allow_infinite](const std::string& t) {
+    const std::string s = Trim(t);
+    const double inf = std::numeric_limits<double>::infinity();
+    double v = 0;
+    if (allow_infinite && (s == "inf" || s == ".inf" || s == "+inf")) {
+      v = inf;
+    } else if (allow_infinite && (s == "-inf" || s == "-.inf")) {
+      v = -inf;
+    } else {
+      v = ParseDouble(t, "");
+    }
     CheckRange(v, lo, hi, Trim(t));
     *field = v;
   };

@@ -39,8 +39,10 @@ class OptionSet {
   void Add(const std::string& name, bool* field, const std::string& help);
   void Add(const std::string& name, int* field, const std::string& help,
            int min_value, int max_value);
+  // allow_infinite: "inf" / "-inf" are valid values (e.g. an open bounding
+  // box); NaN never is.
   void Add(const std::string& name, double* field, const std::string& help,
-           double min_value, double max_value);
+           double min_value, double max_value, bool allow_infinite = false);
   void Add(const std::string& name, float* field, const std::string& help,
            double min_value, double max_value);
   void Add(const std::string& name, std::string* field,

@@ -4,6 +4,12 @@
 // The keys are section.key where the section names the option struct:
 //   run.*      the tool itself (threads, stages)
 //   image.*    ImageOptions (image loading and cache)
+//   tracker.*  TrackerOptions (sparse tracks from known poses;
+//              tracker.features.* its FeatureOptions)
+//   mvs.*      MvsOptions (mvs.global, mvs.rescaling, mvs.local, mvs.mpgc,
+//              mvs.growing, mvs.sweep: the per-view depth map)
+//   fusion.*   FusionOptions (consistency-checked fusion)
+// Keys are the C++ member names, so the headers document them.
 // The default config file config/reconstruct.yaml is exactly
 // `wild_mvs reconstruct --dump-config` with the defaults (a test checks it).
 #pragma once
@@ -12,7 +18,10 @@
 #include <vector>
 
 #include "wild_mvs/cli/option_set.h"
+#include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/core/reconstruct_view.h"
+#include "wild_mvs/core/sparse_tracker.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -29,6 +38,9 @@ struct RunOptions {
 struct ReconstructConfig {
   RunOptions run;
   ImageOptions image;
+  TrackerOptions tracker;
+  MvsOptions mvs;
+  FusionOptions fusion;
   // Runs every struct's Check() (errors name section.key and the value).
   void Check() const;
 };

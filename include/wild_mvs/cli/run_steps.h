@@ -1,0 +1,89 @@
+// Copyright wild_mvs authors. The stages of `wild_mvs reconstruct`, shared
+// with `sparse`, `fuse` and `mesh`: sparse tracks, per-view depth maps
+// (resumable), fusion, meshing, and the run record OUT/run.yaml that lets
+// `fuse OUT` / `mesh OUT` find the dataset and the options again.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "wild_mvs/cli/option_set.h"
+#include "wild_mvs/cli/reconstruct_config.h"
+#include "wild_mvs/core/image.h"
+#include "wild_mvs/core/point_cloud.h"
+#include "wild_mvs/core/scene.h"
+#include "wild_mvs/core/thread_pool.h"
+
+namespace wild_mvs {
+namespace cli {
+
+// Process CPU time (user + system) in seconds, all threads.
+double CpuSeconds();
+// Peak resident set size of the process in MB.
+double PeakRssMb();
+
+struct SparseSummary {
+  size_t points = 0, observations = 0;
+  double median_track_length = 0, median_error = 0;
+  double seconds = 0;
+};
+// Replaces scene->points with tracks computed from the known poses
+// (ComputeSparseTracks) and logs what happened.
+SparseSummary ComputeSceneTracks(Scene* scene, const ReconstructConfig& config,
+                                 ThreadPool* pool, std::ostream& log);
+
+struct DepthStageResult {
+  int computed = 0, skipped = 0;
+  long long samples = 0;  // valid depth samples over all selected views
+  double seconds = 0;
+  std::vector<std::string> failures;  // "view: problem"
+};
+// True when view `stem`'s files in `out` are complete (depth, camera and
+// log written; the camera file is written after the maps, the log last).
+bool ViewOutputsComplete(const std::string& out, const std::string& stem);
+// Depth maps of `views` (in order): skips complete views unless `force`,
+// writes depth/normal/confidence/cameras/preview files and log/S.json. A
+// view that fails (bad image, ...) is reported in `failures` and the others
+// go on; output write errors abort (Error).
+DepthStageResult RunDepthStage(const Scene& scene,
+                               const std::vector<int>& views,
+                               ImageCache& images,
+                               const ReconstructConfig& config,
+                               ThreadPool* pool, const std::string& out,
+                               bool force, std::ostream& log);
+
+struct FuseResult {
+  int views = 0;
+  size_t points = 0;
+  double seconds = 0;
+};
+// Fuses the depth maps found in `out` for the views of `scene` (scene
+// order), streaming them from disk; writes `ply` atomically. `cloud`
+// (optional) receives the cloud.
+FuseResult RunFuseStage(const Scene& scene, ImageCache* images,
+                        const ReconstructConfig& config, ThreadPool* pool,
+                        const std::string& out, const std::string& ply,
+                        std::ostream& log, PointCloud* cloud = nullptr);
+
+struct MeshResult {
+  size_t vertices = 0, faces = 0;
+  double seconds = 0;
+};
+// Reads a fused cloud (binary PLY).
+PointCloud LoadFusedCloud(const std::string& path);
+
+// Poisson mesh of `cloud`, trimmed, written to `ply` atomically.
+MeshResult RunMeshStage(const PointCloud& cloud,
+                        const ReconstructConfig& config, const std::string& ply,
+                        std::ostream& log);
+
+// What `reconstruct` ran on, stored in OUT/run.yaml with all options.
+struct DatasetRecord {
+  std::string path, model, images, format = "auto", mask_dir;
+};
+void RegisterDatasetRecord(DatasetRecord* record, OptionSet* set);
+std::string RunRecordPath(const std::string& out);
+
+}  // namespace cli
+}  // namespace wild_mvs

@@ -1,0 +1,42 @@
+// Copyright wild_mvs authors. Preparing a loaded Scene for the CLI commands:
+// dataset flags, image size limit, masks, view selection.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "wild_mvs/cli/args.h"
+#include "wild_mvs/core/scene.h"
+#include "wild_mvs/io/dataset.h"
+
+namespace wild_mvs {
+namespace cli {
+
+// DatasetOptions from the --model / --images / --format flags of `args`.
+DatasetOptions MakeDatasetOptions(const std::string& path, const Args& args);
+
+// Downscales every view whose image's longest side exceeds max_size pixels:
+// the camera becomes Camera::Scaled (View::file_width/height keep the file's
+// size, so LoadViewImage resizes at load) and the view's track observations
+// and feature scales are scaled with it. max_size = 0: no change. Returns
+// the number of views changed.
+int LimitImageSize(Scene* scene, int max_size);
+
+// Sets View::mask_path from `dir`: for image NAME (stem S) the first of
+// DIR/NAME.png (COLMAP's convention), DIR/S.png, DIR/NAME that exists.
+// Returns the number of views that got a mask; throws Error naming `dir`
+// when it is not a folder or no view has a mask in it.
+int AssignMasks(Scene* scene, const std::string& dir);
+
+// The view's mask (CV_8U, 0 = ignore) at its camera's resolution (a mask of
+// the image file's size is resized, nearest neighbour), or an empty Mat.
+// Throws Error naming the file when it is unreadable or of another size.
+cv::Mat LoadMaskForView(const View& view);
+
+// Indices of the views named in a comma-separated list (image names or
+// stems); "" = all views. Throws UsageError naming an unknown entry.
+std::vector<int> SelectViews(const Scene& scene, const std::string& list);
+
+}  // namespace cli
+}  // namespace wild_mvs

@@ -1,0 +1,141 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/cli/scene_setup.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <set>
+
+namespace wild_mvs {
+namespace cli {
+
+namespace fs = std::filesystem;
+
+DatasetOptions MakeDatasetOptions(const std::string& path, const Args& args) {
+  DatasetOptions o;
+  o.path = path;
+  o.model_dir = args.Get("model");
+  o.images_dir = args.Get("images");
+  try {
+    o.format = ParseDatasetFormat(args.Get("format", "auto"), "--format");
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
+  o.Check();  // a missing dataset folder is an input error (status 1)
+  return o;
+}
+
+int LimitImageSize(Scene* scene, int max_size) {
+  if (max_size <= 0) return 0;
+  std::vector<Eigen::Vector2d> factor(scene->views.size(),
+                                      Eigen::Vector2d(1, 1));
+  std::vector<double> scale(scene->views.size(), 1.0);
+  int changed = 0;
+  for (size_t i = 0; i < scene->views.size(); ++i) {
+    View& v = scene->views[i];
+    const int fw = v.file_width > 0 ? v.file_width : v.camera.width;
+    const int fh = v.file_height > 0 ? v.file_height : v.camera.height;
+    const int longest = std::max(fw, fh);
+    if (longest <= max_size) continue;
+    const Camera file_cam = v.camera.Resized(fw, fh);
+    const Camera small =
+        file_cam.Scaled(static_cast<double>(max_size) / longest);
+    factor[i] =
+        Eigen::Vector2d(static_cast<double>(small.width) / v.camera.width,
+                        static_cast<double>(small.height) / v.camera.height);
+    scale[i] = 0.5 * (factor[i].x() + factor[i].y());
+    v.file_width = fw;
+    v.file_height = fh;
+    v.camera = small;
+    ++changed;
+  }
+  if (changed == 0) return 0;
+  for (SparsePoint& p : scene->points) {
+    for (Observation& o : p.track) {
+      if (o.view < 0 || o.view >= static_cast<int>(factor.size())) continue;
+      // Continuous pixel coordinates with the (0.5, 0.5) centre convention
+      // scale about the image corner, like the intrinsics.
+      o.xy = o.xy.cwiseProduct(factor[o.view]);
+      o.scale *= scale[o.view];
+    }
+  }
+  return changed;
+}
+
+int AssignMasks(Scene* scene, const std::string& dir) {
+  std::error_code ec;
+  Require(fs::is_directory(dir, ec), dir, ": mask folder does not exist");
+  int found = 0;
+  for (View& v : scene->views) {
+    const std::string candidates[] = {dir + "/" + v.name + ".png",
+                                      dir + "/" + v.Stem() + ".png",
+                                      dir + "/" + v.name};
+    for (const std::string& c : candidates) {
+      if (fs::is_regular_file(c, ec)) {
+        v.mask_path = c;
+        ++found;
+        break;
+      }
+    }
+  }
+  Require(
+      found > 0, dir,
+      ": no mask found for any view (expected "
+      "<image name>.png or <image stem>.png, e.g. ",
+      scene->views.empty() ? std::string("?") : scene->views[0].Stem() + ".png",
+      ")");
+  return found;
+}
+
+cv::Mat LoadMaskForView(const View& v) {
+  if (v.mask_path.empty()) return cv::Mat();
+  cv::Mat m = cv::imread(v.mask_path, cv::IMREAD_GRAYSCALE);
+  Require(!m.empty(), v.mask_path, ": cannot read mask image");
+  const int fw = v.file_width > 0 ? v.file_width : v.camera.width;
+  const int fh = v.file_height > 0 ? v.file_height : v.camera.height;
+  const bool camera_size =
+      m.cols == v.camera.width && m.rows == v.camera.height;
+  Require(camera_size || (m.cols == fw && m.rows == fh), v.mask_path,
+          ": mask is ", m.cols, "x", m.rows, " but image '", v.name, "' is ",
+          fw, "x", fh);
+  if (!camera_size) {
+    cv::Mat small;
+    cv::resize(m, small, cv::Size(v.camera.width, v.camera.height), 0, 0,
+               cv::INTER_NEAREST);
+    m = small;
+  }
+  return m;
+}
+
+std::vector<int> SelectViews(const Scene& scene, const std::string& list) {
+  std::vector<int> out;
+  if (list.empty()) {
+    for (size_t i = 0; i < scene.views.size(); ++i) {
+      out.push_back(static_cast<int>(i));
+    }
+    return out;
+  }
+  std::set<int> seen;
+  for (const std::string& item : SplitList(list)) {
+    int index = scene.FindView(item);
+    for (size_t i = 0; index < 0 && i < scene.views.size(); ++i) {
+      if (scene.views[i].Stem() == item) index = static_cast<int>(i);
+    }
+    if (index < 0) {
+      std::string names;
+      for (size_t i = 0; i < scene.views.size() && i < 8; ++i) {
+        names += (i ? ", " : "") + scene.views[i].name;
+      }
+      if (scene.views.size() > 8) names += ", ...";
+      throw UsageError(Msg("--views: no view named '", item,
+                           "' in the dataset (views: ", names, ")"));
+    }
+    if (seen.insert(index).second) out.push_back(index);
+  }
+  Require(!out.empty(), "--views: the list is empty");
+  return out;
+}
+
+}  // namespace cli
+}  // namespace wild_mvs
