@@ -332,28 +332,66 @@ struct SparseTracker::Impl {
       return;
     }
     PointData pd;
-    std::vector<int> nodes;
-    std::map<int, int> node_of_slot;
+    // Per view, the distinct features of the component (SIFT orientation
+    // twins at the same position count once).
+    std::map<int, std::vector<int>> by_slot;
     std::vector<int> sorted = mit->second;
     std::sort(sorted.begin(), sorted.end());  // deterministic twin choice
     for (int n : sorted) {
       const int s = node_slot[n];
       const ViewData& v = views[s];
       if (v.removed) continue;
-      auto it = node_of_slot.find(s);
-      if (it != node_of_slot.end()) {
-        // Two features of one view: SIFT orientation twins (same position)
-        // are one point; otherwise the track is inconsistent.
-        if ((v.features.xy[n - v.offset] - v.features.xy[it->second - v.offset])
-                .norm() > kTwinDistance) {
-          pd.conflict = true;
-        }
-        continue;
+      std::vector<int>& list = by_slot[s];
+      bool twin = false;
+      for (int m : list) {
+        twin =
+            twin || (v.features.xy[n - v.offset] - v.features.xy[m - v.offset])
+                            .norm() <= kTwinDistance;
       }
-      node_of_slot[s] = n;
-      nodes.push_back(n);
+      if (!twin) list.push_back(n);
     }
-    if (pd.conflict || static_cast<int>(nodes.size()) < opt.min_track_length) {
+    std::vector<int> nodes;
+    std::vector<int> conflicting;  // slots with several distinct features
+    for (const auto& kv : by_slot) {
+      if (kv.second.size() == 1) {
+        nodes.push_back(kv.second[0]);
+      } else {
+        conflicting.push_back(kv.first);
+      }
+    }
+    if (!conflicting.empty()) {
+      pd.conflict = true;
+      if (!opt.resolve_conflicts ||
+          static_cast<int>(nodes.size()) < opt.min_track_length) {
+        points[root] = pd;
+        return;
+      }
+      // Point from the unambiguous views; in each conflicting view keep the
+      // feature that reprojects best, if within the error bound.
+      std::vector<TriangulationInput> clean;
+      for (int n : nodes) {
+        const ViewData& v = views[node_slot[n]];
+        clean.push_back(
+            {&v.camera, v.features.xy[n - v.offset].cast<double>()});
+      }
+      Eigen::Vector3d Xc;
+      if (!Triangulate(clean, &Xc, opt.refine_iterations)) {
+        points[root] = pd;
+        return;
+      }
+      for (int s : conflicting) {
+        const ViewData& v = views[s];
+        int best = -1;
+        double best_err = opt.max_reprojection_error;
+        for (int n : by_slot[s]) {
+          const double e = ReprojectionError(
+              v.camera, Xc, v.features.xy[n - v.offset].cast<double>());
+          if (e <= best_err) best_err = e, best = n;
+        }
+        if (best >= 0) nodes.push_back(best);
+      }
+    }
+    if (static_cast<int>(nodes.size()) < opt.min_track_length) {
       points[root] = pd;
       return;
     }

@@ -78,6 +78,11 @@ struct TrackerOptions {
   // of different sizes (on the synthetic ring scenes this removes about a
   // quarter of the wrong 2-view tracks and ~1 % of the right ones). 0 = off.
   double max_scale_ratio = 1.8;
+  // A track with two distinct features in one view (a wrong match joined
+  // two points) is rejected when false. When true, the point is triangulated
+  // from the views with one feature and, in each ambiguous view, the feature
+  // that reprojects best (within max_reprojection_error) is kept.
+  bool resolve_conflicts = false;
   // Tracks shorter than this (views) produce no point.
   int min_track_length = 2;
   // Gauss-Newton iterations of the nonlinear refinement.
@@ -93,10 +98,14 @@ struct TrackerStats {
   long long matches = 0;
   long long features = 0;
   int tracks = 0;              // components with >= 2 features
-  int conflicting_tracks = 0;  // rejected: two features in one view
+  int conflicting_tracks = 0;  // two distinct features in one view
   int points = 0;              // tracks that passed every filter
 };
 
+// Not thread-safe: call its methods from one thread at a time (the
+// streaming node serialises AddView/RemoveView/Points with a mutex).
+// Memory: descriptors (128 B per feature, capped by features.max_features)
+// of the views currently held, plus 8 B per feature ever added (union-find).
 class SparseTracker {
  public:
   // `pool` (optional, not owned) parallelises matching inside AddView; call
