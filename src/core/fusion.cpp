@@ -101,11 +101,7 @@ struct StreamingFusion::Accum {
 namespace {
 constexpr uint32_t kNone = 0xffffffffu;
 
-uint64_t CellKey(int level, const Eigen::Vector3d& X) {
-  const double size = std::ldexp(1.0, level);
-  const int64_t x = static_cast<int64_t>(std::floor(X.x() / size));
-  const int64_t y = static_cast<int64_t>(std::floor(X.y() / size));
-  const int64_t z = static_cast<int64_t>(std::floor(X.z() / size));
+uint64_t CellKey(int level, int64_t x, int64_t y, int64_t z) {
   // Mix into 64 bits; collisions only lengthen a chain (merging still
   // requires the distance test).
   uint64_t h = static_cast<uint64_t>(level + 1024) * 0x9E3779B97F4A7C15ull;
@@ -114,6 +110,13 @@ uint64_t CellKey(int level, const Eigen::Vector3d& X) {
     h *= 0xBF58476D1CE4E5B9ull;
   }
   return h ^ (h >> 31);
+}
+
+uint64_t CellKey(int level, const Eigen::Vector3d& X) {
+  const double size = std::ldexp(1.0, level);
+  return CellKey(level, static_cast<int64_t>(std::floor(X.x() / size)),
+                 static_cast<int64_t>(std::floor(X.y() / size)),
+                 static_cast<int64_t>(std::floor(X.z() / size)));
 }
 
 // Level whose cell size 2^level is in [radius, 2 radius).
@@ -398,10 +401,9 @@ bool Agrees(const MapT& u, const Eigen::Vector3d& X, const Eigen::Vector3f& N,
 }  // namespace
 
 void StreamingFusion::Insert(const Sample& s) {
-  // Cells of the sample's level are at least `radius` wide, so the 2x2x2
-  // cells nearest to the sample hold every point of that level within the
-  // radius; the two adjacent levels are searched the same way (footprints
-  // vary across views).
+  // Cells of the sample's level are at least `radius` wide; the sample's
+  // level and the two adjacent ones are searched (footprints vary across
+  // views) in the cells that a ball of the merge radius overlaps.
   const double radius = options_.cell_scale * s.footprint;
   const int level = Level(radius);
   const float w = s.confidence;
@@ -410,16 +412,18 @@ void StreamingFusion::Insert(const Sample& s) {
   for (int dl : {0, -1, 1}) {
     const int lv = level + dl;
     const double size = std::ldexp(1.0, lv);
-    const Eigen::Vector3d f = s.X / size;
-    const Eigen::Vector3d step(f.x() - std::floor(f.x()) < 0.5 ? -1 : 1,
-                               f.y() - std::floor(f.y()) < 0.5 ? -1 : 1,
-                               f.z() - std::floor(f.z()) < 0.5 ? -1 : 1);
-    for (int dx = 0; dx <= 1; ++dx)
-      for (int dy = 0; dy <= 1; ++dy)
-        for (int dz = 0; dz <= 1; ++dz) {
-          const Eigen::Vector3d off(dx * step.x(), dy * step.y(),
-                                    dz * step.z());
-          auto it = hash_.find(CellKey(lv, s.X + size * off));
+    // Points of level lv have radius < size: only the cells that the ball
+    // of radius min(radius, size) overlaps can hold a merge candidate.
+    const double rr = std::min(radius, size);
+    int64_t c0[3], c1[3];
+    for (int ax = 0; ax < 3; ++ax) {
+      c0[ax] = static_cast<int64_t>(std::floor((s.X[ax] - rr) / size));
+      c1[ax] = static_cast<int64_t>(std::floor((s.X[ax] + rr) / size));
+    }
+    for (int64_t x = c0[0]; x <= c1[0]; ++x)
+      for (int64_t y = c0[1]; y <= c1[1]; ++y)
+        for (int64_t z = c0[2]; z <= c1[2]; ++z) {
+          auto it = hash_.find(CellKey(lv, x, y, z));
           if (it == hash_.end()) continue;
           for (uint32_t k = it->second; k != kNone; k = points_[k].next) {
             const Accum& a = points_[k];
@@ -571,6 +575,7 @@ void StreamingFusion::AddView(int view) {
   std::vector<Pending> new_pending;
   const Eigen::Vector3f grey = Eigen::Vector3f::Constant(SrgbToLinear(0.5f));
   const double pending_cap = options_.pending_mb * kMB;
+  const Eigen::Vector3d cam_center = cv_cam.Center();
   for (int r = 0; r < H; ++r) {
     for (int c = 0; c < W; ++c) {
       const size_t i = static_cast<size_t>(r) * W + c;
@@ -587,7 +592,12 @@ void StreamingFusion::AddView(int view) {
         s.rgb = grey;
       }
       s.confidence = V.confidence[i];
-      s.footprint = static_cast<float>(cv_cam.PixelFootprint(d));
+      // Footprint on the surface: the pixel footprint stretched by the
+      // slant (capped at 1.5x), so oblique views merge instead of piling up.
+      const double cos_view = std::abs(static_cast<double>(
+          s.N.dot((s.X - cam_center).normalized().cast<float>())));
+      s.footprint = static_cast<float>(cv_cam.PixelFootprint(d) /
+                                       std::max(cos_view, 2.0 / 3.0));
       s.support = support[i];
       if (s.support >= options_.min_support) {
         Insert(s);
