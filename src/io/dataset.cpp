@@ -125,11 +125,13 @@ std::string ChooseColmapImages(const Scene& s, const fs::path& model,
   std::vector<fs::path> cand;
   fs::path a = fs::absolute(model).lexically_normal();
   const fs::path b = fs::absolute(base).lexically_normal();
+  // The model folder and up to 3 parents (also above DIR, so that a model
+  // folder given as the dataset, e.g. DIR/sparse/0, finds DIR/images).
   for (int depth = 0; depth < 4 && !a.empty(); ++depth) {
     cand.push_back(a / "images");
     cand.push_back(a / "images_undistorted");
     cand.push_back(a);
-    if (a == b || a == a.parent_path()) break;
+    if (a == a.parent_path()) break;
     a = a.parent_path();
   }
   cand.push_back(b / "images");

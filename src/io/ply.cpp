@@ -340,8 +340,10 @@ Mesh Read(const std::string& path, bool want_faces) {
     size_t min_bytes = 0;
     for (const Property& p : el.props)
       min_bytes += p.is_list ? SizeOf(p.count_type) : SizeOf(p.type);
+    // ASCII: each value takes at least one character and one separator
+    // (the very last one may lack its separator).
     if (body.ascii()) min_bytes = el.props.empty() ? 0 : 2 * el.props.size();
-    if (min_bytes > 0 && el.count > body.remaining() / min_bytes)
+    if (min_bytes > 0 && el.count > (body.remaining() + 1) / min_bytes)
       throw Error(Msg(el.where, ": element '", el.name, "' count ", el.count,
                       " does not fit in the remaining ", body.remaining(),
                       " bytes (corrupt or truncated file)"));

@@ -201,6 +201,9 @@ TEST(Dataset, ColmapLayoutsAndOverrides) {
   EXPECT_EQ(s.views[1].image_path,
             (fs::path(d) / "a/images/im1.png").lexically_normal().string());
   EXPECT_NE(s.source.find("sparse/0"), std::string::npos) << s.source;
+  // The model folder given as the dataset still finds DIR/images.
+  EXPECT_EQ(Load(d + "/a/sparse/0").views[0].image_path,
+            (fs::path(d) / "a/images/im0.png").lexically_normal().string());
   // DIR/sparse + images beside it.
   WriteColmapText(t, d + "/b/sparse");
   WriteImage(d + "/b/im0.png", 32, 24);

@@ -111,6 +111,11 @@ TEST(Ply, ReadsAsciiAndBigEndianAndQuads) {
   EXPECT_EQ(m.vertices.rgb[1], Eigen::Vector3f(0, 1, 0));
   ASSERT_EQ(m.faces.size(), 2u);  // quad -> 2 triangles
   EXPECT_EQ(m.faces[1], Eigen::Vector3i(0, 2, 3));
+  // No newline after the last value.
+  WriteBytes(d + "/n.ply",
+             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+             "property float y\nproperty float z\nend_header\n1 2 3");
+  EXPECT_EQ(ReadPlyCloud(d + "/n.ply").xyz[0], Eigen::Vector3f(1, 2, 3));
   // Big endian float xyz.
   std::string be =
       "ply\nformat binary_big_endian 1.0\nelement vertex 1\n"

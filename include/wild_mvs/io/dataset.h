@@ -5,8 +5,9 @@
 //  colmap      COLMAP text or binary model in DIR/sparse/0/, DIR/sparse/,
 //              DIR/, DIR/colmap_sift_gt/, DIR/colmap/, then any sub-folder
 //              (depth <= 2, sorted). Images: the first of
-//              M/images, M/images_undistorted, M, then the same for each
-//              parent of the model folder M up to DIR, in which every image
+//              M/images, M/images_undistorted, M, then the same for up to
+//              3 parents of the model folder M, then DIR/images, DIR, in
+//              which every image
 //              NAME exists with the camera's size (e.g. DIR/images/ for
 //              DIR/sparse/0, DIR for the shared colmap_sift_gt/ models).
 //  bundler     DIR/bundle/bundle.out or DIR/bundle.out, with list.txt in
