@@ -30,14 +30,11 @@ foreach(t ${_wild_mvs_targets})
   endif()
 endforeach()
 # Coverage feedback for the code under test.
-foreach(lib wild_mvs_core wild_mvs_io)
-  target_compile_options(${lib} PRIVATE -fsanitize=fuzzer-no-link)
+foreach(lib wild_mvs_core wild_mvs_io wild_mvs_cli)
+  if(TARGET ${lib})
+    target_compile_options(${lib} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
 endforeach()
-
-# Sources of the command-line tool for the YAML config harness (src/cli/ has
-# no library of its own): everything but main().
-file(GLOB WILD_MVS_FUZZ_CLI_SRC CONFIGURE_DEPENDS src/cli/*.cpp)
-list(REMOVE_ITEM WILD_MVS_FUZZ_CLI_SRC ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/main.cpp)
 
 add_custom_target(fuzzers)
 file(GLOB WILD_MVS_FUZZ_HARNESSES CONFIGURE_DEPENDS test/fuzz/fuzz_*.cpp)
@@ -48,9 +45,7 @@ endif()
 foreach(src ${WILD_MVS_FUZZ_HARNESSES})
   get_filename_component(name ${src} NAME_WE)
   set(extra)
-  if(name STREQUAL "fuzz_yaml_config")
-    set(extra ${WILD_MVS_FUZZ_CLI_SRC})
-  elseif(name STREQUAL "fuzz_ros_messages")
+  if(name STREQUAL "fuzz_ros_messages")
     # Compiled into the harness (with coverage) rather than linking the
     # whole ROS layer library.
     set(extra ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/conversions.cpp)
@@ -61,7 +56,10 @@ foreach(src ${WILD_MVS_FUZZ_HARNESSES})
   target_compile_options(${name} PRIVATE -fsanitize=fuzzer
                          ${WILD_MVS_FUZZ_SANITIZERS} ${WILD_MVS_WARNINGS})
   target_link_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
-  target_link_libraries(${name} PRIVATE wild_mvs_io yaml-cpp)
+  target_link_libraries(${name} PRIVATE wild_mvs_io)
+  if(name STREQUAL "fuzz_yaml_config")
+    target_link_libraries(${name} PRIVATE wild_mvs_cli)  # OptionSet, config
+  endif()
   set_target_properties(${name} PROPERTIES
     RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
   if(name STREQUAL "fuzz_ros_messages")

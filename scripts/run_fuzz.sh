@@ -7,7 +7,8 @@
 #   HARNESS   names like fuzz_pfm (default: every harness built, i.e. each
 #             test/fuzz/fuzz_*.cpp, and test/fuzz/ros/ when ROS is found)
 # Environment: JOBS harnesses run in parallel (default: number of cores),
-#   FUZZ_BUILD_DIR (default build-fuzz).
+#   FUZZ_BUILD_DIR (default build-fuzz), FUZZ_SEED (libFuzzer -seed; default
+#   1 so that a CI run is repeatable, 0 = random).
 # Prints executions and findings per harness; exits non-zero when any
 # harness found a crash, a sanitizer report, a leak, a timeout or an
 # out-of-memory. Findings are kept in build-fuzz/findings/<harness>/; to
@@ -43,8 +44,8 @@ cmake -S "$ROOT" -B "$FUZZ_BUILD_DIR" -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
   -DWILD_MVS_FUZZ=ON -DWILD_MVS_WITH_ROS="$ros" -DWILD_MVS_BUILD_TESTS=OFF \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
-  "${launcher[@]}" >"$FUZZ_BUILD_DIR.cmake.log" 2>&1 ||
-  { cat "$FUZZ_BUILD_DIR.cmake.log"; exit 1; }
+  "${launcher[@]}" >"$FUZZ_BUILD_DIR/cmake.log" 2>&1 ||
+  { cat "$FUZZ_BUILD_DIR/cmake.log"; exit 1; }
 cmake --build "$FUZZ_BUILD_DIR" -j"$JOBS" --target fuzzers
 
 if [ $# -gt 0 ]; then
@@ -72,7 +73,8 @@ run_one() {  # harness
   local log="$FUZZ_BUILD_DIR/logs/$h.log"
   rm -rf "$findings"
   mkdir -p "$work" "$findings" "$(dirname "$log")"
-  local args=(-max_total_time="$SECONDS_PER" -timeout=10 -rss_limit_mb=2048
+  local args=(-max_total_time="$SECONDS_PER" -seed="${FUZZ_SEED:-1}"
+    -timeout=10 -rss_limit_mb=2048
     -malloc_limit_mb=1024 -print_final_stats=1 -artifact_prefix="$findings/")
   [ -f "$ROOT/test/fuzz/$h.dict" ] && args+=(-dict="$ROOT/test/fuzz/$h.dict")
   local dirs=("$work")
@@ -110,7 +112,8 @@ for h in "${harnesses[@]}"; do
     result=ok
   else
     failed=1
-    result="FINDING (exit $rc): $(grep -Eo 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer|UndefinedBehaviorSanitizer)[^(]*' "$log" | head -1)$(grep -Eo 'runtime error: .*' "$log" | head -1)$(grep -Eo "terminate called after throwing.*" "$log" | head -1)"
+    what="$(grep -Eo 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer|UndefinedBehaviorSanitizer)[^(]*|runtime error: .*|terminate called after throwing.*|what\(\): .*' "$log" | head -2 | tr '\n' ' ' || true)"
+    result="FINDING (exit $rc): $what"
   fi
   printf '%-26s %12s %10s %8s  %s\n' "$h" "${execs:-?}" "${rate:-?}" "${cov:-?}" "$result"
 done

@@ -31,7 +31,7 @@ configure() {  # build-dir cmake-args...
   mkdir -p "$dir"
   cmake -S "$ROOT" -B "$dir" -DWILD_MVS_WITH_ROS=OFF \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
-    "${launcher[@]}" "$@" >"$dir.cmake.log" 2>&1 || { cat "$dir.cmake.log"; return 1; }
+    "${launcher[@]}" "$@" >"$dir/cmake.log" 2>&1 || { cat "$dir/cmake.log"; return 1; }
 }
 
 status=0
@@ -47,13 +47,13 @@ if [ "$do_asan" = 1 ]; then
   export LSAN_OPTIONS="suppressions=$SUPP/lsan.supp:print_suppressions=0"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   if ctest --test-dir "$ASAN_BUILD_DIR" --output-on-failure -j"$JOBS" \
-    2>&1 | tee "$ASAN_BUILD_DIR.ctest.log"; then
+    2>&1 | tee "$ASAN_BUILD_DIR/ctest.log"; then
     :
   else
     status=1
   fi
-  if grep -Eq 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$ASAN_BUILD_DIR.ctest.log"; then
-    echo "run_sanitizers.sh: sanitizer findings (see $ASAN_BUILD_DIR.ctest.log)"
+  if grep -Eq 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$ASAN_BUILD_DIR/ctest.log"; then
+    echo "run_sanitizers.sh: sanitizer findings (see $ASAN_BUILD_DIR/ctest.log)"
     status=1
   fi
   unset ASAN_OPTIONS LSAN_OPTIONS UBSAN_OPTIONS
@@ -79,13 +79,13 @@ if [ "$do_tsan" = 1 ]; then
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$SUPP/tsan.supp"
     # ctest -j1: TSan tests use every core themselves.
     if ctest --test-dir "$TSAN_BUILD_DIR" --output-on-failure -R "$TSAN_TESTS" \
-      2>&1 | tee "$TSAN_BUILD_DIR.ctest.log"; then
+      2>&1 | tee "$TSAN_BUILD_DIR/ctest.log"; then
       :
     else
       status=1
     fi
-    if grep -q 'WARNING: ThreadSanitizer' "$TSAN_BUILD_DIR.ctest.log"; then
-      echo "run_sanitizers.sh: ThreadSanitizer findings (see $TSAN_BUILD_DIR.ctest.log)"
+    if grep -q 'WARNING: ThreadSanitizer' "$TSAN_BUILD_DIR/ctest.log"; then
+      echo "run_sanitizers.sh: ThreadSanitizer findings (see $TSAN_BUILD_DIR/ctest.log)"
       status=1
     fi
     unset TSAN_OPTIONS

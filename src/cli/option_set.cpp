@@ -221,8 +221,10 @@ void OptionSet::LoadYamlString(const std::string& text,
       [&](const YAML::Node& map, const std::string& prefix) {
         std::set<std::string> seen;
         for (auto it = map.begin(); it != map.end(); ++it) {
-          const YAML::Node& key = it->first;
-          const YAML::Node& value = it->second;
+          // Copies: `it->first` lives in a proxy that dies at the end of
+          // the full expression (a reference dangles; found by fuzzing).
+          const YAML::Node key = it->first;
+          const YAML::Node value = it->second;
           const std::string where = Location(source, key.Mark());
           Require(key.IsScalar(), where, ": keys must be plain names");
           const std::string name = prefix + key.Scalar();

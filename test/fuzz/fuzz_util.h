@@ -11,11 +11,14 @@
 // hang, a huge allocation) is a finding.
 #pragma once
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
@@ -63,7 +66,7 @@ inline const std::string& ScratchDir() {
     if (!mkdtemp(buf.data())) std::abort();
     std::atexit([] {
       for (const std::string& n : ScratchNames())
-        std::remove((ScratchDir() + "/" + n).c_str());
+        std::remove((ScratchDir() + "/" + n).c_str());  // files, empty dirs
       rmdir(ScratchDir().c_str());
     });
     return std::string(buf.data());
@@ -91,6 +94,24 @@ inline std::string WriteScratch(const std::string& name,
 inline void RemoveScratch(const std::string& name) {
   const std::string path = ScratchDir() + "/" + name;
   std::remove(path.c_str());
+}
+
+// Small images a.png, b.png, c.png (640x480, 320x240, 64x48) in the scratch
+// folder and in its images/ subfolder, for readers that take image sizes
+// from the files their cameras name (Bundler, Middlebury).
+inline void WriteSampleImages() {
+  const int sizes[3][2] = {{640, 480}, {320, 240}, {64, 48}};
+  const char* names[3] = {"a.png", "b.png", "c.png"};
+  mkdir((ScratchDir() + "/images").c_str(), 0755);
+  for (int i = 0; i < 3; ++i) {
+    const cv::Mat img(sizes[i][1], sizes[i][0], CV_8UC3,
+                      cv::Scalar(40 * i, 100, 200));
+    for (const std::string sub : {"", "images/"}) {
+      if (!cv::imwrite(ScratchDir() + "/" + sub + names[i], img)) std::abort();
+      ScratchNames().push_back(sub + names[i]);
+    }
+  }
+  ScratchNames().push_back("images");  // removed last (after its files)
 }
 
 }  // namespace fuzz

@@ -157,9 +157,11 @@ def par_seeds():
         p = os.path.join(SHARED, rel)
         if not os.path.exists(p):
             continue
-        lines = data_lines(read_lines(p))
+        lines = data_lines(read_lines(p))[1:4]
+        lines = [n + l[l.index(" "):] for n, l in
+                 zip(["a.png", "b.png", "c.png"], lines)]
         put("middlebury_par", os.path.basename(p).replace(".txt", ""),
-            "3\n" + "\n".join(lines[1:4]) + "\n")
+            "3\n" + "\n".join(lines) + "\n")
 
 
 def strecha_seeds():
@@ -168,7 +170,12 @@ def strecha_seeds():
         p = os.path.join(SHARED, rel)
         if os.path.exists(p):
             with open(p, "rb") as f:
-                put("strecha_camera", rel.split("/")[0], f.read())
+                put("strecha_camera", rel.split("/")[0], b"\0" + f.read())
+    d = os.path.join(SHARED, "pavilion_chair_sequence/cameras")
+    for name in ["029.projmatrix", "067.projmatrix"]:
+        if os.path.exists(os.path.join(d, name)):
+            with open(os.path.join(d, name), "rb") as f:
+                put("strecha_camera", "pavilion_" + name, b"\1" + f.read())
 
 
 def rot_to_quat_inv(q):
@@ -211,10 +218,12 @@ def bundler_seeds():
             y = float(c[3]) / 2 - float(obs[idx][1])
             entries.append("%d %d %.3f %.3f" % (idx_of[iid], idx, x, y))
         out += "%d %s\n" % (len(entries), " ".join(entries))
-    lst = "".join("images/%s 0 %s\n" % (h[9], cams[h[8]][4]) for h, _ in images)
+    names = ["a.png", "b.png", "c.png"]  # images the harness provides
+    lst = "".join("images/%s 0 %s\n" % (n, cams[h[8]][4])
+                  for n, (h, _) in zip(names, images))
     put("bundler", "temple", out + "#WMSPLIT" + lst)
     put("bundler", "temple_plain_list",
-        out + "#WMSPLIT" + "".join("%s\n" % h[9] for h, _ in images))
+        out + "#WMSPLIT" + "".join("%s\n" % n for n in names))
 
 
 def pfm_seeds():
@@ -256,6 +265,28 @@ def ply_seeds():
     xyz = ("ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\n"
            "property double y\nproperty double z\nend_header\n1 2 3\n4 5 6\n")
     put("ply", "ascii_xyz_double", xyz)
+
+
+def image_size_seeds():
+    import zlib
+    def chunk(t, d):
+        return (struct.pack(">I", len(d)) + t + d +
+                struct.pack(">I", zlib.crc32(t + d) & 0xffffffff))
+    raw = b"".join(b"\0" + bytes(3 * 4) for _ in range(3))
+    png = (b"\x89PNG\r\n\x1a\n" +
+           chunk(b"IHDR", struct.pack(">IIBBBBB", 4, 3, 8, 2, 0, 0, 0)) +
+           chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+    put("image_size", "png_4x3", png)
+    put("image_size", "pnm_p6", b"P6\n# comment\n5 2\n255\n" + bytes(30))
+    put("image_size", "pfm", b"Pf\n2 2\n-1\n" + bytes(16))
+    bmp = (b"BM" + struct.pack("<IHHI", 54 + 16, 0, 0, 54) +
+           struct.pack("<IiiHHIIiiII", 40, 2, -2, 1, 24, 0, 16, 0, 0, 0, 0) +
+           bytes(16))
+    put("image_size", "bmp_top_down", bmp)
+    jpg = (b"\xff\xd8\xff\xe0" + struct.pack(">H", 16) + b"JFIF\0" +
+           bytes(9) + b"\xff\xc0" + struct.pack(">HBHHB", 11, 8, 6, 7, 1) +
+           b"\x01\x11\x00" + b"\xff\xd9")
+    put("image_size", "jpeg_sof0_header", jpg)
 
 
 def ros_seeds():
@@ -301,6 +332,7 @@ if __name__ == "__main__":
     pfm_seeds()
     ply_seeds()
     ros_seeds()
+    image_size_seeds()
     for h in sorted(os.listdir(CORPUS)):
         files = os.listdir(os.path.join(CORPUS, h))
         size = sum(os.path.getsize(os.path.join(CORPUS, h, f)) for f in files)
