@@ -56,9 +56,13 @@ void TrackerOptions::Check() const {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-// SIFT reports one keypoint per dominant orientation: features of one view
-// closer than this (pixels) are the same point.
-constexpr float kTwinDistance = 1.0f;
+// SIFT reports one keypoint per dominant orientation, at the same position
+// and size: such twins in one view are the same point. (Distinct features
+// merely close to each other are not twins.)
+bool IsTwin(const Features& f, int a, int b) {
+  return (f.xy[a] - f.xy[b]).squaredNorm() <= 1e-4f &&
+         std::abs(f.scale[a] - f.scale[b]) <= 0.01f * f.scale[a];
+}
 
 struct ViewData {
   int id = -1;
@@ -132,8 +136,8 @@ std::vector<Match> MatchPair(const ViewData& a, const ViewData& b,
   // Best and second-best per feature. SIFT reports one keypoint per dominant
   // orientation, so a feature may appear twice at the same position: such a
   // twin of the best candidate is the same physical point and must not fail
-  // the ratio test, so the second best is taken among candidates more than
-  // kTwinDistance pixels from the best.
+  // the ratio test, so the second best is taken among the candidates that
+  // are not twins of the best.
   const int kInf = std::numeric_limits<int>::max();
   struct Best {
     int idx = -1, d1 = std::numeric_limits<int>::max(),
@@ -146,11 +150,11 @@ std::vector<Match> MatchPair(const ViewData& a, const ViewData& b,
   }
   for (const Cand& c : cands) {
     Best& ba = best_a[c.i];
-    if (c.j != ba.idx && (fb.xy[c.j] - fb.xy[ba.idx]).norm() > kTwinDistance) {
+    if (c.j != ba.idx && !IsTwin(fb, c.j, ba.idx)) {
       ba.d2 = std::min(ba.d2, c.d);
     }
     Best& bb = best_b[c.j];
-    if (c.i != bb.idx && (fa.xy[c.i] - fa.xy[bb.idx]).norm() > kTwinDistance) {
+    if (c.i != bb.idx && !IsTwin(fa, c.i, bb.idx)) {
       bb.d2 = std::min(bb.d2, c.d);
     }
   }
@@ -344,9 +348,7 @@ struct SparseTracker::Impl {
       std::vector<int>& list = by_slot[s];
       bool twin = false;
       for (int m : list) {
-        twin =
-            twin || (v.features.xy[n - v.offset] - v.features.xy[m - v.offset])
-                            .norm() <= kTwinDistance;
+        twin = twin || IsTwin(v.features, n - v.offset, m - v.offset);
       }
       if (!twin) list.push_back(n);
     }
@@ -546,6 +548,24 @@ void SparseTracker::AddView(int view_index, const Camera& camera,
     m.parent.push_back(nv.offset + i);
     m.node_slot.push_back(slot);
   }
+  // SIFT orientation twins (features at the same position) are one point:
+  // link them so that matches through either twin build one track.
+  {
+    std::vector<int> by_x(nv.count);
+    std::iota(by_x.begin(), by_x.end(), 0);
+    const auto& xy = nv.features.xy;
+    std::sort(by_x.begin(), by_x.end(), [&xy](int a, int b) {
+      return xy[a].x() < xy[b].x() || (xy[a].x() == xy[b].x() && a < b);
+    });
+    for (size_t a = 0; a < by_x.size(); ++a) {
+      for (size_t b = a + 1;
+           b < by_x.size() && xy[by_x[b]].x() - xy[by_x[a]].x() <= 0.01f; ++b) {
+        if (IsTwin(nv.features, by_x[a], by_x[b])) {
+          m.Union(nv.offset + by_x[a], nv.offset + by_x[b]);
+        }
+      }
+    }
+  }
   std::vector<int> touched;
   for (size_t k = 0; k < nb.size(); ++k) {
     const ViewData& old = m.views[nb[k]];
@@ -617,7 +637,7 @@ TrackerStats SparseTracker::Stats() const {
   }
   s.pairs_matched = m.pairs_matched;
   s.matches = m.matches;
-  s.tracks = static_cast<int>(m.members.size());
+  s.tracks = static_cast<int>(m.points.size());
   for (const auto& kv : m.points) {
     if (kv.second.conflict) ++s.conflicting_tracks;
     if (kv.second.valid) ++s.points;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,13 @@ TEST(SparseTrackerReal, TempleSparseRing) {
   EXPECT_GE(pts.size(), 2000u);
   EXPECT_LT(median, 0.5);
   EXPECT_GE(inside, 0.9 * pts.size());
+  // SIFT orientation twins (same position and size, two descriptors) form
+  // one track, not two identical points.
+  std::vector<std::array<double, 3>> xyz;
+  for (const SparsePoint& p : pts)
+    xyz.push_back({p.xyz.x(), p.xyz.y(), p.xyz.z()});
+  std::sort(xyz.begin(), xyz.end());
+  EXPECT_EQ(std::adjacent_find(xyz.begin(), xyz.end()), xyz.end());
 
   // Resolving conflicting tracks instead of rejecting them keeps more
   // points, still within the error bound.

@@ -97,7 +97,7 @@ struct TrackerStats {
   int pairs_matched = 0;
   long long matches = 0;
   long long features = 0;
-  int tracks = 0;              // components with >= 2 features
+  int tracks = 0;              // components that received matches
   int conflicting_tracks = 0;  // two distinct features in one view
   int points = 0;              // tracks that passed every filter
 };
