@@ -108,36 +108,50 @@ int RunReconstruct(const CommandArgs& argv) {
   record.images = args.Get("images");
   record.format = args.Get("format", "auto");
   record.mask_dir = args.Get("mask-dir");
-  // Options that change existing results (everything but run.*): warn when
-  // they differ from the recorded ones of an earlier run.
-  {
+  // Compare with the options of an earlier run in OUT (run.yaml): depth
+  // maps computed with other depth options are kept (resuming is the point)
+  // but the user is told; the cloud and the mesh are redone when their
+  // options (or their inputs) changed.
+  bool fusion_options_changed = true, mesh_options_changed = true;
+  if (fs::exists(RunRecordPath(out)) && !force) {
     ReconstructConfig before;
     DatasetRecord before_record;
     OptionSet previous;
     RegisterOptions(&before, &previous);
     RegisterDatasetRecord(&before_record, &previous);
-    if (fs::exists(RunRecordPath(out)) && !force) {
-      try {
-        previous.LoadYamlFile(RunRecordPath(out));
-        std::string changed;
-        for (size_t i = 0; i < options.entries().size(); ++i) {
-          const auto& now = options.entries()[i];
-          const auto& was = previous.entries()[i];
-          if (now.name.rfind("run.", 0) == 0) continue;
-          if (now.get() != was.get()) {
-            changed +=
-                Msg("\n    ", now.name, ": ", was.get(), " -> ", now.get());
-          }
+    try {
+      previous.LoadYamlFile(RunRecordPath(out));
+      std::string depth_changes;
+      fusion_options_changed = mesh_options_changed = false;
+      for (size_t i = 0; i < options.entries().size(); ++i) {
+        const auto& now = options.entries()[i];
+        const auto& was = previous.entries()[i];
+        if (now.get() == was.get()) continue;
+        if (now.name.rfind("run.", 0) == 0) continue;
+        if (now.name.rfind("fusion.", 0) == 0) {
+          fusion_options_changed = true;
+        } else if (now.name.rfind("meshing.", 0) == 0) {
+          mesh_options_changed = true;
+        } else {
+          depth_changes +=
+              Msg("\n    ", now.name, ": ", was.get(), " -> ", now.get());
         }
-        if (!changed.empty()) {
-          log << "note: " << RunRecordPath(out)
-              << ": the existing results were computed with other options; "
-                 "finished views are kept (use --force to recompute):"
-              << changed << "\n";
-        }
-      } catch (const Error& e) {
-        log << "note: ignoring the earlier run record: " << e.what() << "\n";
       }
+      if (before_record.path != record.path) {
+        log << "warning: " << out << " holds results of another dataset ("
+            << before_record.path << "); views with the same names are "
+            << "treated as done (use --force or another OUT)\n";
+        fusion_options_changed = true;
+      }
+      if (!depth_changes.empty()) {
+        log << "note: " << RunRecordPath(out)
+            << ": finished depth maps were computed with other options; they "
+               "are kept (use --force to recompute):"
+            << depth_changes << "\n";
+      }
+    } catch (const Error& e) {
+      log << "note: ignoring the earlier run record: " << e.what() << "\n";
+      fusion_options_changed = mesh_options_changed = true;
     }
   }
   OptionSet record_set;
@@ -202,7 +216,8 @@ int RunReconstruct(const CommandArgs& argv) {
   bool have_cloud = false, fused_now = false;
   FuseResult fuse;
   if (config.run.HasStage("fuse")) {
-    if (!force && depth.computed == 0 && fs::exists(fused)) {
+    if (!force && depth.computed == 0 && !fusion_options_changed &&
+        fs::exists(fused)) {
       log << "fuse: " << fused
           << " is up to date, skipped (--force recomputes)\n";
     } else {
@@ -214,7 +229,8 @@ int RunReconstruct(const CommandArgs& argv) {
   MeshResult mesh;
   bool meshed = false;
   if (config.run.HasStage("mesh")) {
-    if (!force && !fused_now && fs::exists(mesh_path)) {
+    if (!force && !fused_now && !mesh_options_changed &&
+        fs::exists(mesh_path)) {
       log << "mesh: " << mesh_path
           << " is up to date, skipped (--force recomputes)\n";
     } else {

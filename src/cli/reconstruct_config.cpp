@@ -41,6 +41,7 @@ void ReconstructConfig::Check() const {
   tracker.Check();
   mvs.Check();
   fusion.Check();
+  mesh.Check();
 }
 
 void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
@@ -221,6 +222,30 @@ void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
            "budget of the depth-map cache in MB", 0, kInf);
   set->Add("fusion.pending_mb", &u.pending_mb,
            "budget of not-yet-supported samples in MB, 0 = none", 0, kInf);
+
+  // Poisson mesh of the fused cloud.
+  MeshingOptions& h = c->mesh;
+  set->Add("meshing.depth", &h.depth,
+           "maximum octree depth of the Poisson solve (resolution 2^depth)", 4,
+           14);
+  set->Add("meshing.point_weight", &h.point_weight,
+           "screening weight of the points, 0 = unscreened Poisson", 0, kInf);
+  set->Add("meshing.samples_per_node", &h.samples_per_node,
+           "minimum samples per octree node (more for noisy data)", 1, kInf);
+  set->Add("meshing.scale", &h.scale,
+           "reconstruction cube / bounding cube of the samples", 1, 4);
+  set->Add("meshing.trim_distance", &h.trim_distance,
+           "remove surface farther than this x local sample spacing from "
+           "the samples, 0 = no trimming",
+           0, kInf);
+  set->Add("meshing.spacing_neighbors", &h.spacing_neighbors,
+           "neighbours defining the local sample spacing", 1, 64);
+  set->Add("meshing.min_component_faces", &h.min_component_faces,
+           "drop connected pieces with fewer faces after trimming", 0, kIntMax);
+  set->Add("meshing.decimation_cell", &h.decimation_cell,
+           "vertex-clustering cell in world units, 0 = no decimation", 0, kInf);
+  set->Add("meshing.threads", &h.threads, "threads of the Poisson solver", 1,
+           256);
 }
 
 }  // namespace cli

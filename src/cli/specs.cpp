@@ -117,7 +117,12 @@ CommandSpec EvalSpec() {
       "  points lie), completeness, precision, recall and F-score per tau\n"
       "  (Middlebury / ETH3D definitions).\n"
       "make-gt-cloud: builds a ground-truth cloud from ground-truth depth\n"
-      "  maps and the dataset's cameras.";
+      "  maps and the dataset's cameras.\n"
+      "Ground truth is looked up as GT_DIR/<stem>.pfm|.exr (rendered with the\n"
+      "view's camera); a folder named gt_depth_blender_exr (fountain-P11) "
+      "gets\n"
+      "the principal-point adapter. Without --gt-dir, DATASET/gt_depth/ and\n"
+      "DATASET/gt_depth_blender_exr/ are used.";
   s.positionals = {"MODE", "ARGS"};
   s.min_positionals = 1;
   s.max_positionals = 3;
@@ -137,6 +142,10 @@ CommandSpec EvalSpec() {
        "0.01,0.02)",
        ""},
       {"stride", "N", "use every N-th pixel (make-gt-cloud; default 2)", ""},
+      {"voxel", "SIZE",
+       "thin clouds to one point per voxel of this size (cloud, "
+       "make-gt-cloud; default off)",
+       ""},
       {"json", "FILE", "also write the scores as JSON", ""},
   };
   return s;

@@ -79,8 +79,9 @@ class CliReconstruct : public ::testing::Test {
     dataset_ = root_ + "/dataset";
     testing::WriteDataset(*scene_, dataset_);
     out_ = root_ + "/out";
+    // All stages; a coarse Poisson depth keeps the test fast.
     first_ = RunCli("reconstruct '" + dataset_ + "' '" + out_ +
-                    "' --threads 2 --stages depth");
+                    "' --threads 2 --meshing.depth 7");
   }
   static void TearDownTestSuite() {
     delete scene_;
@@ -103,6 +104,8 @@ TEST_F(CliReconstruct, WritesAccurateDepthMapsForEveryView) {
       << first_.output;
   EXPECT_EQ(CountTempFiles(out_), 0);
   EXPECT_TRUE(fs::exists(out_ + "/run.yaml"));
+  EXPECT_TRUE(fs::exists(out_ + "/fused.ply"));
+  EXPECT_TRUE(fs::exists(out_ + "/mesh.ply"));
   EXPECT_TRUE(fs::exists(out_ + "/summary.json"));
   for (size_t i = 0; i < scene_->scene.views.size(); ++i) {
     const View& v = scene_->scene.views[i];
@@ -140,10 +143,17 @@ TEST_F(CliReconstruct, SecondRunResumesAndForceRecomputes) {
   const std::string s0 = scene_->scene.views[0].Stem();
   const auto t0 = fs::last_write_time(out_ + "/depth/" + s0 + ".pfm");
   const std::string depth0 = ReadFile(out_ + "/depth/" + s0 + ".pfm");
+  const auto fused_time = fs::last_write_time(out_ + "/fused.ply");
   const RunResult again = RunCli("reconstruct '" + dataset_ + "' '" + out_ +
-                                 "' --threads 2 --stages depth");
+                                 "' --threads 2 --meshing.depth 7");
   ASSERT_EQ(again.status, 0) << again.output;
   EXPECT_EQ(Count(again.output, "done earlier, skipped"), 4) << again.output;
+  EXPECT_NE(again.output.find("fused.ply is up to date, skipped"),
+            std::string::npos)
+      << again.output;
+  EXPECT_NE(again.output.find("mesh.ply is up to date, skipped"),
+            std::string::npos);
+  EXPECT_EQ(fs::last_write_time(out_ + "/fused.ply"), fused_time);
   EXPECT_NE(again.output.find("(0 computed, 4 resumed)"), std::string::npos);
   EXPECT_EQ(fs::last_write_time(out_ + "/depth/" + s0 + ".pfm"), t0);
 
@@ -165,6 +175,74 @@ TEST_F(CliReconstruct, SecondRunResumesAndForceRecomputes) {
       << forced.output;
   EXPECT_EQ(ReadFile(out_ + "/depth/" + s0 + ".pfm"), depth0);
   EXPECT_EQ(CountTempFiles(out_), 0);
+}
+
+TEST_F(CliReconstruct, EvalScoresDepthMapsAndCloudAgainstGroundTruth) {
+  ASSERT_EQ(first_.status, 0) << first_.output;
+  // Depth maps against the dataset's gt_depth/ (found via --dataset, or
+  // given with --gt-dir): same numbers either way.
+  const RunResult a = RunCli("eval depth --est '" + out_ + "' --dataset '" +
+                             dataset_ + "' --json '" + root_ + "/d.json'");
+  ASSERT_EQ(a.status, 0) << a.output;
+  const RunResult b = RunCli("eval depth --est '" + out_ + "' --gt-dir '" +
+                             dataset_ + "/gt_depth'");
+  ASSERT_EQ(b.status, 0) << b.output;
+  const std::string tail_a = a.output.substr(a.output.find("all 4 views"));
+  EXPECT_EQ(tail_a, b.output.substr(b.output.find("all 4 views")));
+  const std::string json = ReadFile(root_ + "/d.json");
+  const size_t c = json.find("\"completeness\": ");
+  ASSERT_NE(c, std::string::npos) << json;
+  EXPECT_GT(std::stod(json.substr(c + 16)), 0.5) << json;
+
+  // The fused cloud against a ground-truth cloud made from the GT depth.
+  const std::string gt = root_ + "/gt.ply";
+  const RunResult g = RunCli("eval make-gt-cloud --dataset '" + dataset_ +
+                             "' --stride 2 '" + gt + "'");
+  ASSERT_EQ(g.status, 0) << g.output;
+  // tau = 1 % of the scene size.
+  const double tau = 0.01 * scene_->scene_size;
+  const RunResult e =
+      RunCli("eval cloud '" + out_ + "/fused.ply' '" + gt + "' --tau " +
+             std::to_string(tau) + " --json '" + root_ + "/c.json'");
+  ASSERT_EQ(e.status, 0) << e.output;
+  const std::string cj = ReadFile(root_ + "/c.json");
+  const size_t f = cj.find("\"fscore\": [");
+  ASSERT_NE(f, std::string::npos) << cj;
+  EXPECT_GT(std::stod(cj.substr(f + 11)), 0.5) << e.output;
+  // The mesh's vertices can be scored too.
+  const RunResult m = RunCli("eval cloud '" + out_ + "/mesh.ply' '" + gt +
+                             "' --tau " + std::to_string(tau));
+  EXPECT_EQ(m.status, 0) << m.output;
+
+  // Usage errors.
+  RunResult u = RunCli("eval depth --est '" + out_ + "'");
+  EXPECT_EQ(u.status, 1) << u.output;
+  EXPECT_NE(u.output.find("needs --gt-dir"), std::string::npos);
+  u = RunCli("eval cloud '" + gt + "' '" + gt + "' --tau 0,1");
+  EXPECT_EQ(u.status, 2) << u.output;
+  EXPECT_NE(u.output.find("--tau: 0 must be > 0"), std::string::npos);
+  u = RunCli("eval cloud '" + root_ + "/missing.ply' '" + gt + "'");
+  EXPECT_EQ(u.status, 1) << u.output;
+  EXPECT_NE(u.output.find("missing.ply"), std::string::npos);
+  u = RunCli("eval bogus");
+  EXPECT_EQ(u.status, 2) << u.output;
+}
+
+TEST_F(CliReconstruct, FuseAndMeshCommandsWorkOnTheFolder) {
+  ASSERT_EQ(first_.status, 0) << first_.output;
+  const RunResult f =
+      RunCli("fuse '" + out_ + "' --output '" + root_ + "/refused.ply'");
+  ASSERT_EQ(f.status, 0) << f.output;
+  // The same cloud as the reconstruct run (same options from run.yaml).
+  EXPECT_EQ(ReadFile(root_ + "/refused.ply"), ReadFile(out_ + "/fused.ply"));
+  const RunResult m = RunCli(
+      "mesh '" + out_ + "' --meshing.depth 6 --output '" + root_ + "/m6.ply'");
+  ASSERT_EQ(m.status, 0) << m.output;
+  EXPECT_TRUE(fs::exists(root_ + "/m6.ply"));
+  const RunResult bad = RunCli("fuse '" + root_ + "/nothing_here'");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.output.find("nothing_here: not a folder"), std::string::npos)
+      << bad.output;
 }
 
 TEST_F(CliReconstruct, OutputDoesNotDependOnThreadCount) {

@@ -9,6 +9,7 @@
 //   mvs.*      MvsOptions (mvs.global, mvs.rescaling, mvs.local, mvs.mpgc,
 //              mvs.growing, mvs.sweep: the per-view depth map)
 //   fusion.*   FusionOptions (consistency-checked fusion)
+//   meshing.*  MeshingOptions (screened Poisson, trimming, decimation)
 // Keys are the C++ member names, so the headers document them.
 // The default config file config/reconstruct.yaml is exactly
 // `wild_mvs reconstruct --dump-config` with the defaults (a test checks it).
@@ -20,6 +21,7 @@
 #include "wild_mvs/cli/option_set.h"
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/core/meshing.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/sparse_tracker.h"
 
@@ -41,6 +43,7 @@ struct ReconstructConfig {
   TrackerOptions tracker;
   MvsOptions mvs;
   FusionOptions fusion;
+  MeshingOptions mesh;
   // Runs every struct's Check() (errors name section.key and the value).
   void Check() const;
 };
