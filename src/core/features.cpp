@@ -26,6 +26,9 @@ void FeatureOptions::Check() const {
           " must be in (0, 10)");
   Require(downscale >= 1 && downscale <= 64, "features.downscale = ", downscale,
           " must be in [1, 64]");
+  Require(max_image_size == 0 || max_image_size >= 64,
+          "features.max_image_size = ", max_image_size,
+          " must be 0 (no limit) or >= 64");
 }
 
 size_t Features::bytes() const {
@@ -105,24 +108,29 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
   const cv::Mat grey_full = ToGrey8(image, options.srgb_encode);
   cv::Mat grey = grey_full;
   cv::Mat det_mask = mask;
-  double s = 1.0;  // full-resolution pixels per detection pixel
-  if (options.downscale > 1.0) {
-    const int w = std::max(
-        1, static_cast<int>(std::lround(grey.cols / options.downscale)));
-    const int h = std::max(
-        1, static_cast<int>(std::lround(grey.rows / options.downscale)));
+  double factor = options.downscale;
+  const int longest = std::max(image.cols, image.rows);
+  if (options.max_image_size > 0 && longest > options.max_image_size) {
+    factor =
+        std::max(factor, static_cast<double>(longest) / options.max_image_size);
+  }
+  // Full-resolution pixels per detection pixel, per axis (equal up to the
+  // rounding of the shrunk size).
+  double sx = 1.0, sy = 1.0;
+  if (factor > 1.0) {
+    const int w =
+        std::max(1, static_cast<int>(std::lround(grey.cols / factor)));
+    const int h =
+        std::max(1, static_cast<int>(std::lround(grey.rows / factor)));
     cv::Mat small;
     cv::resize(grey, small, cv::Size(w, h), 0, 0, cv::INTER_AREA);
     grey = small;
     if (!mask.empty()) {
       cv::resize(mask, det_mask, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
     }
-    s = static_cast<double>(image.cols) /
-        w;  // equal to rows / h up to rounding
+    sx = static_cast<double>(image.cols) / w;
+    sy = static_cast<double>(image.rows) / h;
   }
-  const double sy = options.downscale > 1.0
-                        ? static_cast<double>(image.rows) / grey.rows
-                        : 1.0;
 
   // nfeatures = 0: detect all, then keep the strongest ourselves with a
   // deterministic tie-break (position).
@@ -162,10 +170,10 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
     // fixed by `enable_precise_upscale` only in 4.8). Both are compensated
     // (kOpenCvToPixel), measured on synthetic blobs in the tests. Then the
     // edge-based coordinates are scaled to full resolution.
-    const float x = static_cast<float>((kp.pt.x + kOpenCvToPixel) * s);
+    const float x = static_cast<float>((kp.pt.x + kOpenCvToPixel) * sx);
     const float y = static_cast<float>((kp.pt.y + kOpenCvToPixel) * sy);
     f.xy.emplace_back(x, y);
-    f.scale.push_back(static_cast<float>(kp.size * 0.5 * (s + sy)));
+    f.scale.push_back(static_cast<float>(kp.size * 0.5 * (sx + sy)));
     // Colour at the nearest full-resolution pixel.
     const int col = std::min(image.cols - 1, std::max(0, static_cast<int>(x)));
     const int row = std::min(image.rows - 1, std::max(0, static_cast<int>(y)));

@@ -71,6 +71,22 @@ TEST(Features, BlobCentreInPixelConvention) {
   }
 }
 
+TEST(Features, MaxImageSizeShrinksLargeImages) {
+  const std::vector<Eigen::Vector2d> centres = {{100.3, 80.6}, {300.5, 200.5}};
+  const cv::Mat img = Blobs(400, 300, centres, 5.0);
+  FeatureOptions opt;
+  opt.max_image_size = 200;  // factor 2
+  const Features f = ExtractFeatures(img, opt);
+  for (const Eigen::Vector2d& c : centres) {
+    const int i = Nearest(f, c);
+    ASSERT_GE(i, 0);
+    EXPECT_LT((f.xy[i].cast<double>() - c).norm(), 0.15);
+  }
+  FeatureOptions bad;
+  bad.max_image_size = 10;
+  EXPECT_THROW(bad.Check(), Error);
+}
+
 TEST(Features, DownscaleKeepsScaleInFullResolutionPixels) {
   const std::vector<Eigen::Vector2d> centres = {{100.5, 100.5}};
   const cv::Mat img = Blobs(200, 200, centres, 5.0);

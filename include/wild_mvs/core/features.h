@@ -34,6 +34,10 @@ struct FeatureOptions {
   // views are large; positions and scales are reported in full-resolution
   // pixels.
   double downscale = 1.0;
+  // Also shrink so that the longest side is at most this many pixels (large
+  // photos: SIFT time grows with the pixel count while the extra
+  // features of a 6-megapixel image rarely help); 0 = no limit.
+  int max_image_size = 2000;
   // Images inside the core are linear; SIFT's thresholds are tuned for
   // display-encoded images, so the grey image is sRGB-encoded first.
   bool srgb_encode = true;
