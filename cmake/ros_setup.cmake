@@ -8,11 +8,11 @@
 set(WILD_MVS_ROS_COMPONENTS
   roscpp nodelet pluginlib std_msgs std_srvs sensor_msgs geometry_msgs
   visualization_msgs diagnostic_msgs diagnostic_updater image_transport
-  tf2 tf2_ros rosbag message_generation)
+  tf2 tf2_ros tf2_msgs rosbag message_generation)
 find_package(catkin REQUIRED COMPONENTS ${WILD_MVS_ROS_COMPONENTS})
 
 add_message_files(DIRECTORY msg FILES
-  DepthView.msg SparsePoint.msg SparsePoints.msg)
+  DepthView.msg TrackedPoint.msg SparsePoints.msg)
 add_service_files(DIRECTORY srv FILES SaveCloud.srv)
 generate_messages(DEPENDENCIES std_msgs sensor_msgs geometry_msgs)
 
@@ -21,4 +21,4 @@ catkin_package(
   LIBRARIES wild_mvs_core wild_mvs_io wild_mvs_ros
   CATKIN_DEPENDS roscpp nodelet std_msgs std_srvs sensor_msgs geometry_msgs
     visualization_msgs diagnostic_msgs diagnostic_updater image_transport
-    tf2 tf2_ros rosbag message_runtime)
+    tf2 tf2_ros tf2_msgs rosbag message_runtime)

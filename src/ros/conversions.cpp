@@ -256,6 +256,26 @@ sensor_msgs::Image NormalsToMsg(const cv::Mat& normals) {
   return MatToMsg(n, enc::TYPE_32FC3);
 }
 
+sensor_msgs::Image ColorToMsg(const cv::Mat& linear_rgb, int w, int h) {
+  Require(linear_rgb.type() == CV_32FC3, "ColorToMsg: image must be CV_32FC3");
+  cv::Mat small;
+  if (linear_rgb.cols == w && linear_rgb.rows == h) {
+    small = linear_rgb;
+  } else {
+    cv::resize(linear_rgb, small, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+  }
+  cv::Mat out(h, w, CV_8UC3);
+  for (int r = 0; r < h; ++r) {
+    const cv::Vec3f* s = small.ptr<cv::Vec3f>(r);
+    cv::Vec3b* d = out.ptr<cv::Vec3b>(r);
+    for (int c = 0; c < w; ++c)
+      for (int k = 0; k < 3; ++k)
+        d[c][k] = cv::saturate_cast<uint8_t>(
+            LinearToSrgb(std::clamp(s[c][k], 0.0f, 1.0f)) * 255.0f + 0.5f);
+  }
+  return MatToMsg(out, enc::RGB8);
+}
+
 void FillDepthView(const DepthMap& dm, const std::string& world_frame,
                    wild_mvs::DepthView* msg) {
   Require(!dm.empty(), "FillDepthView: empty depth map");

@@ -77,6 +77,9 @@ sensor_msgs::Image DepthToMsg(const cv::Mat& depth);
 sensor_msgs::Image ConfidenceToMsg(const cv::Mat& confidence);
 sensor_msgs::Image NormalsToMsg(const cv::Mat& normals);  // 0 -> NaN
 
+// An rgb8 (sRGB) image of a linear RGB CV_32FC3 image resized to w x h.
+sensor_msgs::Image ColorToMsg(const cv::Mat& linear_rgb, int w, int h);
+
 // --- DepthView ------------------------------------------------------------
 // Fills depth, confidence, normals, camera_info and camera_pose (header,
 // ids and world frame are left to the caller).

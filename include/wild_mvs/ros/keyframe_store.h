@@ -36,6 +36,7 @@ struct Keyframe {
   std::string frame_id;       // camera optical frame of the image
   Camera camera;              // of `image` (undistorted, maybe downscaled)
   cv::Mat image;              // CV_32FC3 linear RGB
+  double image_scale = 1;     // image size / received image size
   bool owned = false;         // this worker reconstructs it
   int reconstructions = 0;    // depth maps produced so far
   double neighbor_score = 0;  // neighbour score at the last reconstruction

@@ -1,0 +1,40 @@
+// Copyright wild_mvs authors. Shared main() of the node executables.
+#pragma once
+
+#include <ros/ros.h>
+
+#include <csignal>
+#include <exception>
+#include <memory>
+
+namespace wild_mvs {
+namespace ros1 {
+
+inline void RequestShutdownOnSignal(int) { ros::requestShutdown(); }
+
+// Runs node type T (constructed from the public and private node handles)
+// until SIGINT or SIGTERM, then destroys it (so its destructor runs: the
+// fusion node saves there). Returns the process exit code.
+template <typename T>
+int RunNode(int argc, char** argv, const char* name) {
+  ros::init(argc, argv, name, ros::init_options::NoSigintHandler);
+  std::signal(SIGINT, RequestShutdownOnSignal);
+  std::signal(SIGTERM, RequestShutdownOnSignal);
+  ros::NodeHandle nh, pnh("~");
+  std::unique_ptr<T> node;
+  try {
+    node = std::make_unique<T>(nh, pnh);
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", pnh.getNamespace().c_str(), e.what());
+    return 1;
+  }
+  ros::AsyncSpinner spinner(2);  // services stay responsive during a save
+  spinner.start();
+  ros::waitForShutdown();
+  spinner.stop();
+  node.reset();
+  return 0;
+}
+
+}  // namespace ros1
+}  // namespace wild_mvs

@@ -1,0 +1,122 @@
+// Copyright wild_mvs authors. The ONE place where ROS parameters become
+// option structs (the nodes' own options and the core's option structs).
+//
+// Parameters are private (~name). Every value is type- and range-checked:
+// a bad value throws wild_mvs::Error naming the parameter and the value, so a
+// node refuses to start with a clear message instead of running with a wrong
+// setting. Unknown private parameters are reported as warnings
+// (UnknownParams) since launch files may carry extra keys.
+//
+// The reading goes through ParamSource so the mapping is unit-tested without
+// a ROS master (MapParamSource); RosParamSource (params_ros.h) reads a
+// ros::NodeHandle.
+#pragma once
+
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "wild_mvs/core/fusion.h"
+#include "wild_mvs/ros/stream_reconstructor.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+// A typed parameter lookup. Get returns false when the parameter is not set
+// and throws Error when it is set with an incompatible type (an int is
+// accepted for a double).
+class ParamSource {
+ public:
+  using Value = std::variant<bool, int, double, std::string>;
+  virtual ~ParamSource() = default;
+  // The value of private parameter `name`, or false when it is unset.
+  virtual bool Lookup(const std::string& name, Value* value) const = 0;
+  // Names (without the private prefix) of every private parameter that is
+  // set, for the unknown-key check.
+  virtual std::vector<std::string> Names() const = 0;
+  // Where the parameters come from, for messages ("/depth_node").
+  virtual std::string Where() const = 0;
+
+  // Typed getters: leave *v untouched when unset.
+  void Get(const std::string& name, bool* v) const;
+  void Get(const std::string& name, int* v) const;
+  void Get(const std::string& name, double* v) const;
+  void Get(const std::string& name, std::string* v) const;
+};
+
+// In-memory parameters (tests, tools).
+class MapParamSource : public ParamSource {
+ public:
+  explicit MapParamSource(std::map<std::string, Value> values = {})
+      : values_(std::move(values)) {}
+  void Set(const std::string& name, Value v) { values_[name] = std::move(v); }
+  bool Lookup(const std::string& name, Value* value) const override;
+  std::vector<std::string> Names() const override;
+  std::string Where() const override { return "parameters"; }
+
+ private:
+  std::map<std::string, Value> values_;
+};
+
+// Options of the depth node (its ROS-side settings plus the stream
+// reconstructor's and the core's options).
+struct DepthNodeOptions {
+  std::string world_frame = "world";  // fixed frame of the poses (REP 105)
+  // "tf": pose = tf2 lookup world_frame <- image frame_id at the image stamp;
+  // "topic": geometry_msgs/PoseStamped on `pose`, matched by stamp.
+  std::string pose_source = "tf";
+  double tf_timeout = 0.2;            // s to wait for tf / a pose
+  double pose_sync_tolerance = 0.01;  // s, pose topic stamp match
+  // "raw" (sensor_msgs/Image on `image`) or "compressed"
+  // (sensor_msgs/CompressedImage on `image/compressed`, decoded here).
+  std::string image_transport = "raw";
+  // "tracker": sparse tracks built online; "topic": wild_mvs/SparsePoints on
+  // `sparse_points`.
+  // "none": no sparse points (frustum-overlap neighbours, sweep seeds).
+  std::string sparse_source = "tracker";
+  int input_queue_size = 5;  // frames waiting for the front end; the oldest
+                             // is dropped (counted) beyond it
+  bool linearize = true;     // inverse sRGB on input images (core image.h)
+  double diagnostics_period = 1.0;  // s
+  // Stamps of frames whose images are wrongly encoded etc. are dropped with
+  // a ROS_ERROR at most every error_throttle seconds per kind of problem.
+  double error_throttle = 5.0;
+  StreamOptions stream;  // keyframes, store, scheduling, core options
+  void Check() const;
+};
+
+struct FusionNodeOptions {
+  std::string world_frame = "world";
+  double publish_period = 1.0;  // s, at most one cloud per period (latched)
+  double mesh_period = 0.0;     // s, mesh Marker period; 0 = no mesh
+  std::string output_path;      // PLY written on shutdown when set
+  int input_queue_size = 10;    // depth views waiting to be fused
+  double diagnostics_period = 1.0;
+  double error_throttle = 5.0;
+  // Cloud published for rviz: at most this many points (uniform subsample);
+  // the saved PLY always has all points. 0 = no limit.
+  int max_published_points = 500000;
+  // Fusion is done in keyframe-id order: a view waits at most this long (s)
+  // for a missing earlier keyframe (several workers deliver out of order).
+  double reorder_timeout = 2.0;
+  // Depth maps held in memory for the consistency checks; older ones are
+  // spilled to spill_dir (a temporary folder when empty) and read back when
+  // needed, so memory stays bounded on long runs.
+  double map_store_mb = 512;
+  std::string spill_dir;
+  FusionOptions fusion;  // the core's fusion options
+  void Check() const;
+};
+
+// Reads the options (defaults for unset parameters), checks them, and throws
+// Error naming "<where>/~<param>" on a bad value.
+DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params);
+FusionNodeOptions ReadFusionNodeOptions(const ParamSource& params);
+// Private parameters that the node does not know (typos), e.g.
+// "keyframe_min_angel".
+std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params);
+std::vector<std::string> UnknownFusionNodeParams(const ParamSource& params);
+
+}  // namespace ros1
+}  // namespace wild_mvs

@@ -1,0 +1,47 @@
+// Copyright wild_mvs authors. A calibrated scene as a rosbag, as a camera
+// driver with localisation would record it (`wild_mvs to-bag`).
+//
+// View i (scene order) becomes, at stamp start_time + i / rate:
+//   /tf                  tf2_msgs/TFMessage world_frame -> camera_frame
+//                        (the camera optical frame, REP 103/105; the pose
+//                        is the camera's pose in the world)
+//   /camera/camera_info  sensor_msgs/CameraInfo (ROS pixel convention, no
+//                        distortion: images are undistorted)
+//   /camera/image_raw    sensor_msgs/Image rgb8 (sRGB, as the camera gives)
+//   /sparse_points       wild_mvs/SparsePoints (with_points): the scene's
+//                        points seen by >= 2 of the views so far, with their
+//                        observations by stamp (ROS pixel convention)
+#pragma once
+
+#include <functional>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "wild_mvs/core/scene.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+struct SceneBagOptions {
+  double rate = 5.0;           // frames per second (Hz)
+  bool with_points = false;    // also write /sparse_points
+  double start_time = 1000.0;  // stamp of the first frame, seconds
+  std::string world_frame = "world";
+  std::string camera_frame = "camera_optical_frame";
+  std::string image_topic = "/camera/image_raw";
+  std::string info_topic = "/camera/camera_info";
+  std::string points_topic = "/sparse_points";
+  void Check() const;
+};
+
+// Writes the bag atomically (temporary file + rename). image(i) returns view
+// i's image as 8-bit sRGB RGB (CV_8UC3) of the camera's size. Throws Error.
+void WriteSceneBag(const Scene& scene,
+                   const std::function<cv::Mat(int)>& image_rgb8,
+                   const std::string& path, const SceneBagOptions& options);
+
+// Linear RGB float (the core's image type) -> 8-bit sRGB RGB.
+cv::Mat LinearToSrgb8(const cv::Mat& linear_rgb);
+
+}  // namespace ros1
+}  // namespace wild_mvs

@@ -1,0 +1,109 @@
+// Copyright wild_mvs authors. wild_mvs_to_bag DATASET OUT.bag [--rate HZ]
+// [--with-points]: a dataset folder (any format LoadDataset reads) as a bag
+// of /camera/image_raw, /camera/camera_info, /tf and optionally
+// /sparse_points (see wild_mvs/ros/scene_bag.h). `wild_mvs to-bag` runs it.
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/image.h"
+#include "wild_mvs/ros/scene_bag.h"
+#if __has_include("wild_mvs/io/dataset.h")
+#include "wild_mvs/io/dataset.h"
+#define WILD_MVS_HAVE_DATASET 1
+#else
+#include "wild_mvs/io/colmap.h"
+#endif
+
+namespace {
+
+const char* kUsage =
+    "usage: wild_mvs_to_bag DATASET OUT.bag [--rate HZ] [--with-points]\n"
+    "                       [--world-frame NAME] [--camera-frame NAME]\n"
+    "Writes the dataset's views as /camera/image_raw (rgb8),\n"
+    "/camera/camera_info and /tf (world -> camera optical frame) at HZ\n"
+    "frames per second (default 5), plus /sparse_points "
+    "(wild_mvs/SparsePoints)\n"
+    "with --with-points.\n";
+
+wild_mvs::Scene Load(const std::string& dir) {
+#ifdef WILD_MVS_HAVE_DATASET
+  wild_mvs::DatasetOptions o;
+  o.path = dir;
+  return wild_mvs::LoadDataset(o);
+#else
+  return wild_mvs::ReadColmapModel(dir + "/sparse", dir + "/images");
+#endif
+}
+
+double ParseDouble(const std::string& opt, const char* s) {
+  char* end = nullptr;
+  const double v = std::strtod(s, &end);
+  wild_mvs::Require(end != s && *end == '\0', opt, ": '", s,
+                    "' is not a number");
+  return v;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    std::string dataset, out;
+    wild_mvs::ros1::SceneBagOptions options;
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto value = [&]() -> const char* {
+        wild_mvs::Require(i + 1 < argc, a, " needs a value");
+        return argv[++i];
+      };
+      if (a == "-h" || a == "--help") {
+        std::fputs(kUsage, stdout);
+        return 0;
+      } else if (a == "--rate") {
+        options.rate = ParseDouble(a, value());
+      } else if (a == "--with-points") {
+        options.with_points = true;
+      } else if (a == "--world-frame") {
+        options.world_frame = value();
+      } else if (a == "--camera-frame") {
+        options.camera_frame = value();
+      } else if (!a.empty() && a[0] == '-') {
+        throw wild_mvs::Error("unknown option '" + a + "'");
+      } else if (dataset.empty()) {
+        dataset = a;
+      } else if (out.empty()) {
+        out = a;
+      } else {
+        throw wild_mvs::Error("unexpected argument '" + a + "'");
+      }
+    }
+    if (dataset.empty() || out.empty()) {
+      std::fputs(kUsage, stderr);
+      return 2;
+    }
+    options.Check();
+    const wild_mvs::Scene scene = Load(dataset);
+    wild_mvs::ImageOptions io;
+    io.linearize = false;  // keep the camera's sRGB values
+    wild_mvs::ros1::WriteSceneBag(
+        scene,
+        [&](int i) {
+          const cv::Mat rgb = wild_mvs::LoadViewImage(scene.views[i], io);
+          // LoadViewImage gives [0, 1] floats in the file's encoding.
+          cv::Mat out8;
+          rgb.convertTo(out8, CV_8UC3, 255.0);
+          return out8;
+        },
+        out, options);
+    std::printf("wrote %s: %zu frames at %.3g Hz%s (%s)\n", out.c_str(),
+                scene.views.size(), options.rate,
+                options.with_points ? " with sparse points" : "",
+                scene.source.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "wild_mvs_to_bag: error: %s\n", e.what());
+    return 1;
+  }
+}

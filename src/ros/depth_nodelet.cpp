@@ -1,0 +1,487 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/ros/depth_nodelet.h"
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <image_transport/image_transport.h>
+#include <nodelet/nodelet.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <wild_mvs/DepthView.h>
+#include <wild_mvs/SparsePoints.h>
+
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <opencv2/calib3d.hpp>
+#include <pluginlib/class_list_macros.hpp>
+#include <thread>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/ros/conversions.h"
+#include "wild_mvs/ros/drop_counter.h"
+#include "wild_mvs/ros/params_ros.h"
+#include "wild_mvs/ros/stream_reconstructor.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+struct DepthNode::Impl {
+  struct Frame {
+    sensor_msgs::ImageConstPtr raw;
+    sensor_msgs::CompressedImageConstPtr compressed;
+    sensor_msgs::CameraInfoConstPtr info;
+    ros::Time stamp;
+    std::string frame_id;
+  };
+
+  ros::NodeHandle nh, pnh;
+  DepthNodeOptions options;
+  DropCounter drops;
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener;
+  std::unique_ptr<image_transport::ImageTransport> it;
+  image_transport::Subscriber image_sub;
+  ros::Subscriber compressed_sub, info_sub, pose_sub, points_sub;
+  ros::Publisher depth_pub, confidence_pub, normals_pub, info_pub, points_pub,
+      view_pub;
+  ros::Timer tick_timer, diag_timer;
+  std::unique_ptr<diagnostic_updater::Updater> updater;
+  std::unique_ptr<StreamReconstructor> stream;
+
+  std::mutex mutex;  // guards the fields below
+  std::condition_variable cv;
+  std::deque<Frame> queue;
+  sensor_msgs::CameraInfoConstPtr latest_info;
+  std::deque<geometry_msgs::PoseStampedConstPtr> poses;
+  bool stop = false;
+  uint64_t received = 0;
+  std::thread frontend;
+
+  double last_stamp = -1;  // front end only
+  std::atomic<uint64_t> reset_count{0};
+
+  std::string Topic(const std::string& name) const {
+    return nh.resolveName(name);
+  }
+
+  // Counts and (throttled) reports one dropped input.
+  void Drop(const std::string& topic, const std::string& problem,
+            const std::string& detail = "") {
+    uint64_t n = 0;
+    const std::string reason = topic + ": " + problem;
+    if (drops.Count(reason, &n)) {
+      ROS_ERROR(
+          "%s: dropped: %s%s%s (%lu so far; throttled to one message "
+          "per %.0f s per problem)",
+          pnh.getNamespace().c_str(), reason.c_str(),
+          detail.empty() ? "" : ": ", detail.c_str(),
+          static_cast<unsigned long>(n), options.error_throttle);
+    }
+  }
+
+  void Enqueue(Frame f) {
+    bool dropped = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      ++received;
+      f.info = latest_info;
+      if (static_cast<int>(queue.size()) >= options.input_queue_size) {
+        queue.pop_front();
+        dropped = true;
+      }
+      queue.push_back(std::move(f));
+    }
+    cv.notify_all();
+    if (dropped)
+      Drop(Topic(options.image_transport == "raw" ? "image"
+                                                  : "image/compressed"),
+           "input queue full (frames arrive faster than they are processed)");
+  }
+
+  void OnImage(const sensor_msgs::ImageConstPtr& msg) {
+    Frame f;
+    f.raw = msg;
+    f.stamp = msg->header.stamp;
+    f.frame_id = msg->header.frame_id;
+    Enqueue(std::move(f));
+  }
+  void OnCompressed(const sensor_msgs::CompressedImageConstPtr& msg) {
+    Frame f;
+    f.compressed = msg;
+    f.stamp = msg->header.stamp;
+    f.frame_id = msg->header.frame_id;
+    Enqueue(std::move(f));
+  }
+  void OnInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex);
+    latest_info = msg;
+  }
+  void OnPose(const geometry_msgs::PoseStampedConstPtr& msg) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      poses.push_back(msg);
+      while (poses.size() > 500) poses.pop_front();
+    }
+    cv.notify_all();
+  }
+  void OnSparsePoints(const wild_mvs::SparsePointsConstPtr& msg) {
+    if (msg->header.frame_id != options.world_frame) {
+      Drop(Topic("sparse_points"), "frame_id '" + msg->header.frame_id +
+                                       "' is not the world frame '" +
+                                       options.world_frame + "'");
+      return;
+    }
+    std::vector<StreamReconstructor::StampedPoint> pts;
+    pts.reserve(msg->points.size());
+    for (const auto& p : msg->points) {
+      StreamReconstructor::StampedPoint q;
+      q.xyz = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
+      if (!q.xyz.allFinite()) continue;
+      const bool have_xy =
+          p.x.size() == p.stamps.size() && p.y.size() == p.stamps.size();
+      for (size_t i = 0; i < p.stamps.size(); ++i) {
+        StreamReconstructor::StampedObservation o;
+        o.stamp = p.stamps[i].toSec();
+        // ROS pixel convention -> core (+0.5).
+        o.xy = have_xy ? Eigen::Vector2d(p.x[i] + 0.5, p.y[i] + 0.5)
+                       : Eigen::Vector2d(NAN, NAN);
+        q.observations.push_back(o);
+      }
+      pts.push_back(std::move(q));
+    }
+    stream->SetSparsePoints(pts);
+  }
+
+  // Pose of the frame from tf or the pose topic; false (and counted) when
+  // there is none within the timeout.
+  bool LookupPose(const Frame& f, Camera* cam) {
+    if (options.pose_source == "tf") {
+      if (f.frame_id.empty()) {
+        Drop(Topic("image"), "image has an empty frame_id (needed for tf)");
+        return false;
+      }
+      geometry_msgs::TransformStamped T;
+      try {
+        T = tf_buffer->lookupTransform(options.world_frame, f.frame_id, f.stamp,
+                                       ros::Duration(options.tf_timeout));
+      } catch (const tf2::TransformException& e) {
+        Drop("tf",
+             "no transform " + options.world_frame + " <- " + f.frame_id +
+                 " at the image stamp within tf_timeout",
+             e.what());
+        return false;
+      }
+      try {
+        SetCameraPose(T.transform, cam);
+      } catch (const Error& e) {
+        Drop("tf", "invalid pose", e.what());
+        return false;
+      }
+      return true;
+    }
+    // Pose topic: the pose whose stamp is closest, within the tolerance.
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration<double>(options.tf_timeout);
+    geometry_msgs::PoseStampedConstPtr best;
+    std::unique_lock<std::mutex> lock(mutex);
+    for (;;) {
+      double best_dt = options.pose_sync_tolerance;
+      for (const auto& p : poses) {
+        const double dt = std::abs((p->header.stamp - f.stamp).toSec());
+        if (dt <= best_dt) {
+          best_dt = dt;
+          best = p;
+        }
+      }
+      if (best || stop) break;
+      if (cv.wait_until(lock, deadline) == std::cv_status::timeout) break;
+    }
+    lock.unlock();
+    if (!best) {
+      Drop(Topic("pose"),
+           "no pose within pose_sync_tolerance of the image "
+           "stamp within tf_timeout");
+      return false;
+    }
+    if (best->header.frame_id != options.world_frame) {
+      Drop(Topic("pose"), "pose frame_id '" + best->header.frame_id +
+                              "' is not the world frame '" +
+                              options.world_frame + "'");
+      return false;
+    }
+    try {
+      SetCameraPose(best->pose, cam);
+    } catch (const Error& e) {
+      Drop(Topic("pose"), "invalid pose", e.what());
+      return false;
+    }
+    return true;
+  }
+
+  void Process(const Frame& f) {
+    const std::string image_topic = Topic(f.raw ? "image" : "image/compressed");
+    if (!f.info) {
+      Drop(Topic("camera_info"), "no camera_info received yet");
+      return;
+    }
+    const double stamp = f.stamp.toSec();
+    if (last_stamp >= 0 && stamp <= last_stamp &&
+        last_stamp - stamp <= options.stream.stamp_reset_threshold) {
+      Drop(image_topic, "stamp out of order (not after the previous frame)");
+      return;
+    }
+    Camera cam;
+    Distortion dist;
+    try {
+      CameraFromCameraInfo(*f.info, &cam, &dist);
+    } catch (const Error& e) {
+      Drop(Topic("camera_info"), "invalid camera_info", e.what());
+      return;
+    }
+    cv::Mat image;
+    try {
+      image = f.raw ? ImageToLinearRgb(*f.raw, options.linearize)
+                    : CompressedToLinearRgb(*f.compressed, options.linearize);
+    } catch (const Error& e) {
+      Drop(image_topic, "invalid image", e.what());
+      return;
+    }
+    if (image.cols != cam.width || image.rows != cam.height) {
+      Drop(
+          image_topic, "image size differs from camera_info",
+          Msg(image.cols, "x", image.rows, " vs ", cam.width, "x", cam.height));
+      return;
+    }
+    if (!dist.IsNone()) {
+      const cv::Mat K = (cv::Mat_<double>(3, 3) << f.info->K[0], 0,
+                         f.info->K[2], 0, f.info->K[4], f.info->K[5], 0, 0, 1);
+      const cv::Mat D = (cv::Mat_<double>(1, 5) << dist.k1, dist.k2, dist.p1,
+                         dist.p2, dist.k3);
+      cv::Mat und;
+      cv::undistort(image, und, K, D, K);
+      image = und;
+    }
+    if (!LookupPose(f, &cam)) return;
+    StreamReconstructor::FrameStatus status;
+    try {
+      status = stream->AddFrame(stamp, f.frame_id, cam, image);
+    } catch (const Error& e) {
+      Drop(image_topic, "rejected frame", e.what());
+      return;
+    }
+    switch (status) {
+      case StreamReconstructor::FrameStatus::kOutOfOrder:
+        Drop(image_topic, "stamp out of order (not after the previous frame)");
+        return;
+      case StreamReconstructor::FrameStatus::kReset:
+        ++reset_count;
+        ROS_WARN(
+            "%s: time or pose jump at stamp %.3f: keyframes and tracks "
+            "reset, starting again from this frame",
+            pnh.getNamespace().c_str(), stamp);
+        break;
+      default:
+        break;
+    }
+    last_stamp = stamp;
+  }
+
+  void FrontEnd() {
+    for (;;) {
+      Frame f;
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        cv.wait(lock, [this] { return stop || !queue.empty(); });
+        if (stop) return;
+        f = std::move(queue.front());
+        queue.pop_front();
+      }
+      try {
+        Process(f);
+      } catch (const std::exception& e) {
+        Drop(Topic("image"), "unexpected error", e.what());
+      }
+    }
+  }
+
+  void Publish(const StreamResult& r) {
+    std_msgs::Header header;
+    header.stamp = ros::Time(r.stamp);
+    header.frame_id = r.frame_id;
+    auto view = boost::make_shared<wild_mvs::DepthView>();
+    view->header = header;
+    view->keyframe_id = r.keyframe_id;
+    view->neighbor_ids = r.neighbor_ids;
+    for (double s : r.neighbor_stamps)
+      view->neighbor_stamps.push_back(ros::Time(s));
+    view->worker_index = options.stream.worker_index;
+    view->revision = r.revision;
+    FillDepthView(r.depth, options.world_frame, view.get());
+    if (!r.image.empty())
+      view->image = ColorToMsg(r.image, r.depth.width(), r.depth.height());
+    view->image.header = header;
+    // Lazy outputs: only built / sent when someone listens.
+    if (depth_pub.getNumSubscribers() > 0) depth_pub.publish(view->depth);
+    if (confidence_pub.getNumSubscribers() > 0)
+      confidence_pub.publish(view->confidence);
+    if (normals_pub.getNumSubscribers() > 0) normals_pub.publish(view->normals);
+    if (info_pub.getNumSubscribers() > 0) info_pub.publish(view->camera_info);
+    if (points_pub.getNumSubscribers() > 0) {
+      sensor_msgs::PointCloud2 pc =
+          CloudToMsg(DepthMapToCloud(r.depth, r.image));
+      pc.header.stamp = header.stamp;
+      pc.header.frame_id = options.world_frame;
+      points_pub.publish(pc);
+    }
+    view_pub.publish(view);
+    ROS_INFO(
+        "%s: keyframe %u (rev %u): %d depth samples, %zu neighbours, "
+        "%.2f s",
+        pnh.getNamespace().c_str(), r.keyframe_id, r.revision,
+        r.depth.CountValid(), r.neighbor_ids.size(), r.seconds);
+  }
+
+  void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    const StreamStats s = stream->Stats();
+    size_t queued = 0;
+    uint64_t recv = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      queued = queue.size();
+      recv = received;
+    }
+    const uint64_t dropped = drops.Total();
+    if (dropped > 0) {
+      stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                    "%lu frames dropped (see dropped: entries)",
+                    static_cast<unsigned long>(dropped));
+    } else {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
+    }
+    stat.add("frames received", recv);
+    stat.add("input queue length", queued);
+    stat.add("input queue size", options.input_queue_size);
+    stat.add("keyframes held", s.keyframes);
+    stat.add("keyframe store MB", s.store_mb);
+    stat.add("keyframes created", s.keyframes_total);
+    stat.add("reconstructions pending", s.pending);
+    stat.add("keyframes waiting", s.waiting);
+    stat.add("depth maps", s.reconstructed);
+    stat.add("depth maps redone", s.redone);
+    stat.add("reconstructions failed", s.failed);
+    stat.add("keyframes evicted before reconstruction", s.evicted_waiting);
+    stat.add("stream resets", s.resets);
+    stat.add("sparse points", s.sparse_points);
+    stat.add("last seconds per depth map", s.last_seconds);
+    stat.add("mean seconds per depth map", s.mean_seconds);
+    stat.add("frames dropped", dropped);
+    for (const auto& [reason, n] : drops.Counts())
+      stat.add("dropped: " + reason, n);
+  }
+};
+
+DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.nh = nh;
+  m.pnh = pnh;
+  RosParamSource params(pnh);
+  m.options = ReadDepthNodeOptions(params);
+  for (const std::string& n : UnknownDepthNodeParams(params))
+    ROS_WARN("%s: unknown parameter '%s' (ignored; see config/depth_node.yaml)",
+             pnh.getNamespace().c_str(), n.c_str());
+  m.drops.set_throttle(m.options.error_throttle);
+  const DepthNodeOptions& o = m.options;
+
+  m.stream = std::make_unique<StreamReconstructor>(
+      o.stream, [&m](const StreamResult& r) { m.Publish(r); },
+      [&m](const std::string& e) {
+        m.Drop("reconstruction", "keyframe failed", e);
+      });
+
+  m.depth_pub = m.pnh.advertise<sensor_msgs::Image>("depth", 2);
+  m.confidence_pub = m.pnh.advertise<sensor_msgs::Image>("confidence", 2);
+  m.normals_pub = m.pnh.advertise<sensor_msgs::Image>("normals", 2);
+  m.info_pub = m.pnh.advertise<sensor_msgs::CameraInfo>("depth_camera_info", 2);
+  m.points_pub = m.pnh.advertise<sensor_msgs::PointCloud2>("points", 2);
+  m.view_pub = m.pnh.advertise<wild_mvs::DepthView>("depth_view", 20);
+
+  if (o.pose_source == "tf") {
+    m.tf_buffer = std::make_unique<tf2_ros::Buffer>(ros::Duration(30.0));
+    m.tf_listener =
+        std::make_unique<tf2_ros::TransformListener>(*m.tf_buffer, m.nh, true);
+  } else {
+    m.pose_sub = m.nh.subscribe("pose", 50, &Impl::OnPose, &m);
+  }
+  if (o.sparse_source == "topic")
+    m.points_sub =
+        m.nh.subscribe("sparse_points", 2, &Impl::OnSparsePoints, &m);
+  m.info_sub = m.nh.subscribe("camera_info", 5, &Impl::OnInfo, &m);
+  if (o.image_transport == "raw") {
+    m.it = std::make_unique<image_transport::ImageTransport>(m.nh);
+    m.image_sub = m.it->subscribe("image", 5, &Impl::OnImage, &m,
+                                  image_transport::TransportHints("raw"));
+  } else {
+    m.compressed_sub =
+        m.nh.subscribe("image/compressed", 5, &Impl::OnCompressed, &m);
+  }
+
+  m.updater = std::make_unique<diagnostic_updater::Updater>(
+      m.nh, m.pnh, m.pnh.getNamespace());
+  m.updater->setHardwareID("wild_mvs_depth");
+  m.updater->add("depth_node", &m, &Impl::Diagnose);
+  m.diag_timer = m.nh.createTimer(
+      ros::Duration(o.diagnostics_period),
+      [&m](const ros::TimerEvent&) { m.updater->force_update(); });
+  m.tick_timer = m.nh.createTimer(
+      ros::Duration(0.2), [&m](const ros::TimerEvent&) { m.stream->Tick(); });
+  m.frontend = std::thread([&m] { m.FrontEnd(); });
+  ROS_INFO(
+      "%s: worker %d of %d, pose from %s, sparse points from %s, world "
+      "frame '%s'",
+      pnh.getNamespace().c_str(), o.stream.worker_index, o.stream.worker_count,
+      o.pose_source.c_str(), o.sparse_source.c_str(), o.world_frame.c_str());
+}
+
+DepthNode::~DepthNode() {
+  Impl& m = *impl_;
+  m.tick_timer.stop();
+  m.diag_timer.stop();
+  {
+    std::lock_guard<std::mutex> lock(m.mutex);
+    m.stop = true;
+  }
+  m.cv.notify_all();
+  if (m.frontend.joinable()) m.frontend.join();
+  m.image_sub.shutdown();
+  m.compressed_sub.shutdown();
+  m.stream.reset();
+}
+
+// The nodelet: the same node inside a nodelet manager.
+class DepthNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    try {
+      node_ =
+          std::make_unique<DepthNode>(getNodeHandle(), getPrivateNodeHandle());
+    } catch (const std::exception& e) {
+      NODELET_FATAL("%s", e.what());
+      throw;
+    }
+  }
+  std::unique_ptr<DepthNode> node_;
+};
+
+}  // namespace ros1
+}  // namespace wild_mvs
+
+PLUGINLIB_EXPORT_CLASS(wild_mvs::ros1::DepthNodelet, nodelet::Nodelet)

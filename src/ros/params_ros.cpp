@@ -1,0 +1,45 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/ros/params_ros.h"
+
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include "wild_mvs/core/error.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+bool RosParamSource::Lookup(const std::string& name, Value* value) const {
+  XmlRpc::XmlRpcValue x;
+  if (!nh_.getParam(name, x)) return false;
+  switch (x.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      *value = static_cast<bool>(x);
+      return true;
+    case XmlRpc::XmlRpcValue::TypeInt:
+      *value = static_cast<int>(x);
+      return true;
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      *value = static_cast<double>(x);
+      return true;
+    case XmlRpc::XmlRpcValue::TypeString:
+      *value = static_cast<std::string>(x);
+      return true;
+    default:
+      throw Error(Msg(Where(), "/", name,
+                      " has an unsupported type (a list or a map where a "
+                      "single value is expected)"));
+  }
+}
+
+std::vector<std::string> RosParamSource::Names() const {
+  std::vector<std::string> all, out;
+  if (!nh_.getParamNames(all)) return out;
+  const std::string prefix = nh_.getNamespace() + "/";
+  for (const std::string& n : all)
+    if (n.compare(0, prefix.size(), prefix) == 0)
+      out.push_back(n.substr(prefix.size()));
+  return out;
+}
+
+}  // namespace ros1
+}  // namespace wild_mvs

@@ -1,0 +1,409 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/ros/stream_reconstructor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <unordered_map>
+
+#include "wild_mvs/core/global_view_selection.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+namespace {
+double WallSeconds() {
+  return std::chrono::duration<double>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
+void StreamOptions::Check() const {
+  keyframes.Check();
+  store.Check();
+  Require(num_threads >= 1, "num_threads = ", num_threads, " must be >= 1");
+  Require(max_pending >= 1, "max_pending = ", max_pending, " must be >= 1");
+  Require(worker_count >= 1, "worker_count = ", worker_count, " must be >= 1");
+  Require(worker_index >= 0 && worker_index < worker_count,
+          "worker_index = ", worker_index,
+          " must be in [0, worker_count = ", worker_count, ")");
+  Require(min_neighbors >= 1, "min_neighbors = ", min_neighbors,
+          " must be >= 1");
+  Require(lookahead >= 0, "lookahead = ", lookahead, " must be >= 0");
+  Require(std::isfinite(idle_flush) && idle_flush >= 0,
+          "idle_flush = ", idle_flush, " must be >= 0 (seconds)");
+  Require(
+      std::isfinite(redo_min_gain) && (redo_min_gain == 0 || redo_min_gain > 1),
+      "redo_min_gain = ", redo_min_gain, " must be 0 (off) or > 1");
+  Require(max_redo >= 0, "max_redo = ", max_redo, " must be >= 0");
+  Require(max_image_size == 0 || max_image_size >= 16,
+          "max_image_size = ", max_image_size, " must be 0 (off) or >= 16");
+  Require(std::isfinite(max_pose_jump) && max_pose_jump >= 0,
+          "max_pose_jump = ", max_pose_jump, " must be >= 0 (0 = off)");
+  Require(std::isfinite(stamp_reset_threshold) && stamp_reset_threshold > 0,
+          "stamp_reset_threshold = ", stamp_reset_threshold, " must be > 0");
+  mvs.Check();
+  if (use_tracker) tracker.Check();
+}
+
+StreamReconstructor::StreamReconstructor(const StreamOptions& options,
+                                         ResultCallback on_result,
+                                         ErrorCallback on_error)
+    : options_(options),
+      on_result_(std::move(on_result)),
+      on_error_(std::move(on_error)),
+      store_(options.store) {
+  options_.Check();
+  if (options_.use_tracker)
+    tracker_ = std::make_unique<SparseTracker>(options_.tracker, nullptr);
+  dispatcher_ = std::make_unique<ThreadPool>(1);
+  if (options_.num_threads > 1)
+    inner_pool_ = std::make_unique<ThreadPool>(options_.num_threads - 1);
+  last_keyframe_wall_ = WallSeconds();
+}
+
+StreamReconstructor::~StreamReconstructor() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+    ++generation_;
+  }
+  dispatcher_.reset();  // queued tasks return at once; waits for a running one
+  inner_pool_.reset();
+}
+
+void StreamReconstructor::ClearLocked() {
+  store_.Clear();
+  points_.clear();
+  stamped_points_.clear();
+  in_flight_.clear();
+  ++generation_;
+  have_last_center_ = false;
+  if (options_.use_tracker)
+    tracker_ = std::make_unique<SparseTracker>(options_.tracker, nullptr);
+  ++stats_.resets;
+  idle_cv_.notify_all();
+}
+
+void StreamReconstructor::Reset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ClearLocked();
+  last_stamp_ = -1;
+}
+
+StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
+    double stamp, const std::string& frame_id, const Camera& camera,
+    const cv::Mat& image) {
+  camera.Validate("frame '" + frame_id + "'");
+  Require(image.type() == CV_32FC3, "frame '", frame_id,
+          "': image must be CV_32FC3");
+  Require(image.cols == camera.width && image.rows == camera.height, "frame '",
+          frame_id, "': image is ", image.cols, "x", image.rows,
+          " but its camera is ", camera.width, "x", camera.height);
+  Require(std::isfinite(stamp), "frame '", frame_id, "': stamp is not finite");
+
+  FrameStatus status = FrameStatus::kKeyframe;
+  KeyframePtr kf;
+  std::vector<KeyframePtr> evicted;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.frames;
+    if (last_stamp_ >= 0 && stamp <= last_stamp_) {
+      if (last_stamp_ - stamp > options_.stamp_reset_threshold) {
+        ClearLocked();
+        status = FrameStatus::kReset;
+      } else {
+        ++stats_.out_of_order;
+        return FrameStatus::kOutOfOrder;
+      }
+    }
+    const Eigen::Vector3d center = camera.Center();
+    if (status != FrameStatus::kReset && have_last_center_ &&
+        options_.max_pose_jump > 0 && stamp - last_stamp_ < 1.0 &&
+        (center - last_center_).norm() > options_.max_pose_jump) {
+      ClearLocked();
+      status = FrameStatus::kReset;
+    }
+    last_stamp_ = stamp;
+    last_center_ = center;
+    have_last_center_ = true;
+    if (!store_.IsNewKeyframe(camera, options_.keyframes))
+      return FrameStatus::kNotKeyframe;
+
+    kf = std::make_shared<Keyframe>();
+    kf->id = next_id_++;
+    kf->stamp = stamp;
+    kf->frame_id = frame_id;
+    kf->camera = camera;
+    kf->image = image;
+    const int longest = std::max(camera.width, camera.height);
+    if (options_.max_image_size > 0 && longest > options_.max_image_size) {
+      const double f = double(options_.max_image_size) / longest;
+      kf->camera = camera.Scaled(f);
+      cv::resize(image, kf->image,
+                 cv::Size(kf->camera.width, kf->camera.height), 0, 0,
+                 cv::INTER_AREA);
+      kf->image_scale = double(kf->camera.width) / camera.width;
+    }
+    kf->owned = static_cast<int>(kf->id % options_.worker_count) ==
+                options_.worker_index;
+    evicted = store_.Add(kf);
+    for (const KeyframePtr& e : evicted)
+      if (!e->done() && !in_flight_.count(e->id)) ++stats_.evicted_waiting;
+    ++stats_.keyframes_total;
+    last_keyframe_wall_ = WallSeconds();
+  }
+
+  if (tracker_) {
+    // Only the front-end thread touches the tracker (see AddFrame).
+    for (const KeyframePtr& e : evicted) tracker_->RemoveView(int(e->id));
+    try {
+      tracker_->AddView(int(kf->id), kf->camera, kf->image);
+    } catch (const std::exception& e) {
+      if (on_error_)
+        on_error_(Msg("tracker: keyframe ", kf->id, ": ", e.what()));
+    }
+    std::vector<SparsePoint> pts = tracker_->Points();
+    std::lock_guard<std::mutex> lock(mutex_);
+    points_ = std::move(pts);
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  ScheduleLocked();
+  return status;
+}
+
+void StreamReconstructor::SetSparsePoints(
+    const std::vector<StampedPoint>& points) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  stamped_points_ = points;
+  ScheduleLocked();
+}
+
+StreamReconstructor::Snapshot StreamReconstructor::MakeSnapshotLocked() const {
+  Snapshot snap;
+  snap.keyframes = store_.All();
+  std::unordered_map<uint32_t, int> index;
+  std::vector<std::pair<double, int>> by_stamp;
+  for (size_t i = 0; i < snap.keyframes.size(); ++i) {
+    const KeyframePtr& k = snap.keyframes[i];
+    View v;
+    v.name = "keyframe_" + std::to_string(k->id);
+    v.camera = k->camera;
+    snap.scene.views.push_back(v);
+    index[k->id] = static_cast<int>(i);
+    by_stamp.emplace_back(k->stamp, static_cast<int>(i));
+  }
+  snap.scene.source = "keyframe store";
+  for (const SparsePoint& p : points_) {
+    SparsePoint q = p;
+    q.track.clear();
+    for (const Observation& o : p.track) {
+      auto it = index.find(static_cast<uint32_t>(o.view));
+      if (it == index.end()) continue;
+      Observation r = o;
+      r.view = it->second;
+      q.track.push_back(r);
+    }
+    if (q.track.size() >= 2) snap.scene.points.push_back(std::move(q));
+  }
+  // Points given by stamp (sparse_points topic).
+  std::sort(by_stamp.begin(), by_stamp.end());
+  auto find_stamp = [&](double s) -> int {
+    auto it = std::lower_bound(by_stamp.begin(), by_stamp.end(),
+                               std::make_pair(s - 1e-4, -1));
+    if (it != by_stamp.end() && std::abs(it->first - s) <= 1e-4)
+      return it->second;
+    return -1;
+  };
+  for (const StampedPoint& p : stamped_points_) {
+    SparsePoint q;
+    q.xyz = p.xyz;
+    for (const StampedObservation& o : p.observations) {
+      const int v = find_stamp(o.stamp);
+      if (v < 0) continue;
+      const KeyframePtr& k = snap.keyframes[v];
+      Observation r;
+      r.view = v;
+      if (std::isfinite(o.xy.x()) && std::isfinite(o.xy.y())) {
+        r.xy = o.xy * k->image_scale;
+      } else if (!k->camera.Project(p.xyz, &r.xy)) {
+        continue;
+      }
+      if (!k->camera.InImage(r.xy)) continue;
+      q.track.push_back(r);
+    }
+    if (q.track.size() >= 2) snap.scene.points.push_back(std::move(q));
+  }
+  snap.points_per_view = snap.scene.PointsPerView();
+  return snap;
+}
+
+StreamReconstructor::Neighborhood StreamReconstructor::Evaluate(
+    const Snapshot& snap, int index) const {
+  Neighborhood nb;
+  if (snap.scene.views.size() < 2) return nb;
+  GlobalViewSelection sel = SelectGlobalViews(
+      snap.scene, index, snap.points_per_view, options_.mvs.global);
+  // Frustum-overlap fallbacks count only when there are no sparse points at
+  // all (otherwise the keyframe should wait for shared features).
+  if (!sel.fallbacks.empty() && !snap.scene.points.empty()) return nb;
+  for (double s : sel.scores) {
+    if (s > 0) {
+      ++nb.good;
+      nb.score += s;
+    }
+  }
+  return nb;
+}
+
+void StreamReconstructor::ScheduleLocked() {
+  ready_waiting_ = 0;
+  if (stopping_ || store_.size() < 2) return;
+  const Snapshot snap = MakeSnapshotLocked();
+  const uint32_t newest = store_.Newest()->id;
+  const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
+  for (size_t i = 0; i < snap.keyframes.size(); ++i) {
+    const KeyframePtr& kf = snap.keyframes[i];
+    if (!kf->owned || in_flight_.count(kf->id)) continue;
+    const bool redo = kf->reconstructions > 0;
+    if (redo && (options_.redo_min_gain <= 0 ||
+                 kf->reconstructions > options_.max_redo))
+      continue;
+    const Neighborhood nb = Evaluate(snap, static_cast<int>(i));
+    // MPGC needs min_active_views neighbours to match at all.
+    if (nb.good <
+        std::max(options_.min_neighbors, options_.mvs.mpgc.min_active_views))
+      continue;
+    if (redo) {
+      if (nb.score < kf->neighbor_score * options_.redo_min_gain) continue;
+    } else {
+      const bool ready =
+          static_cast<int>(newest - kf->id) >= options_.lookahead ||
+          nb.good >= options_.mvs.global.num_neighbors || idle;
+      if (!ready) continue;
+    }
+    if (static_cast<int>(in_flight_.size()) >= options_.max_pending) {
+      ++ready_waiting_;  // ready, waits for a free slot
+      continue;
+    }
+    in_flight_.insert(kf->id);
+    const uint32_t id = kf->id;
+    const uint64_t gen = generation_;
+    dispatcher_->Submit([this, id, gen] { RunReconstruction(id, gen); });
+  }
+}
+
+void StreamReconstructor::Tick() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ScheduleLocked();
+}
+
+void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
+  Snapshot snap;
+  KeyframePtr kf;
+  int ref = -1;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_ || generation != generation_) {
+      in_flight_.erase(id);
+      idle_cv_.notify_all();
+      return;
+    }
+    kf = store_.Get(id);
+    if (!kf) {  // evicted while queued
+      in_flight_.erase(id);
+      ++stats_.evicted_waiting;
+      idle_cv_.notify_all();
+      return;
+    }
+    snap = MakeSnapshotLocked();
+    for (size_t i = 0; i < snap.keyframes.size(); ++i)
+      if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
+  }
+  StreamResult result;
+  result.keyframe_id = id;
+  result.stamp = kf->stamp;
+  result.frame_id = kf->frame_id;
+  result.image = kf->image;
+  std::string error;
+  double score = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    const std::vector<KeyframePtr>& kfs = snap.keyframes;
+    ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
+    ViewReport report;
+    result.depth = ReconstructView(snap.scene, ref, cache, options_.mvs,
+                                   inner_pool_.get(), &report);
+    result.depth.view = static_cast<int>(id);
+    result.depth.neighbors.clear();
+    for (int n : report.neighbors) {
+      if (n < 0 || n >= static_cast<int>(kfs.size())) continue;
+      result.neighbor_ids.push_back(kfs[n]->id);
+      result.neighbor_stamps.push_back(kfs[n]->stamp);
+      result.depth.neighbors.push_back(static_cast<int>(kfs[n]->id));
+    }
+    for (double s : report.neighbor_scores) score += s;
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
+          .count();
+  bool deliver = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    in_flight_.erase(id);
+    if (generation != generation_) {
+      ++stats_.stale_results;
+    } else if (!error.empty()) {
+      ++stats_.failed;
+      ++kf->reconstructions;  // do not retry in a loop
+    } else {
+      result.revision = kf->reconstructions;
+      if (kf->reconstructions > 0) ++stats_.redone;
+      ++kf->reconstructions;
+      kf->neighbor_score = score;
+      ++stats_.reconstructed;
+      total_seconds_ += result.seconds;
+      stats_.last_seconds = result.seconds;
+      stats_.mean_seconds = total_seconds_ / stats_.reconstructed;
+      deliver = true;
+    }
+  }
+  if (!error.empty() && on_error_)
+    on_error_(Msg("keyframe ", id, ": reconstruction failed: ", error));
+  if (deliver && on_result_) on_result_(result);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ScheduleLocked();
+  idle_cv_.notify_all();
+}
+
+void StreamReconstructor::WaitIdle() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_cv_.wait(lock, [this] { return in_flight_.empty(); });
+}
+
+StreamStats StreamReconstructor::Stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  StreamStats s = stats_;
+  s.keyframes = store_.size();
+  s.store_mb = store_.bytes() / (1024.0 * 1024.0);
+  s.pending = static_cast<int>(in_flight_.size());
+  s.waiting = ready_waiting_;
+  s.sparse_points = points_.size() + stamped_points_.size();
+  return s;
+}
+
+int StreamReconstructor::GoodNeighbors(uint32_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Snapshot snap = MakeSnapshotLocked();
+  for (size_t i = 0; i < snap.keyframes.size(); ++i)
+    if (snap.keyframes[i]->id == id)
+      return Evaluate(snap, static_cast<int>(i)).good;
+  return 0;
+}
+
+}  // namespace ros1
+}  // namespace wild_mvs

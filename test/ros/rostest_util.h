@@ -1,0 +1,132 @@
+// Copyright wild_mvs authors. Helpers of the rostest checker nodes.
+#pragma once
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <ros/network.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <xmlrpcpp/XmlRpcClient.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "wild_mvs/core/point_cloud.h"
+
+namespace wild_mvs {
+namespace testing {
+
+// Latest diagnostics values per status name ("depth_node: depth_node").
+class DiagnosticsWatch {
+ public:
+  explicit DiagnosticsWatch(ros::NodeHandle& nh) {
+    sub_ = nh.subscribe("/diagnostics", 50, &DiagnosticsWatch::On, this);
+  }
+  // Values of the newest status whose name contains `name_part`.
+  std::map<std::string, std::string> Values(const std::string& name_part) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [name, vals] : latest_)
+      if (name.find(name_part) != std::string::npos) return vals;
+    return {};
+  }
+  long Get(const std::string& name_part, const std::string& key) {
+    auto v = Values(name_part);
+    auto it = v.find(key);
+    return it == v.end() ? -1 : std::atol(it->second.c_str());
+  }
+  // Sum of the "dropped: ..." entries of `name_part` whose key contains
+  // `reason_part`.
+  long Dropped(const std::string& name_part, const std::string& reason_part) {
+    long n = 0;
+    for (const auto& [k, v] : Values(name_part))
+      if (k.rfind("dropped: ", 0) == 0 &&
+          k.find(reason_part) != std::string::npos)
+        n += std::atol(v.c_str());
+    return n;
+  }
+  std::string Dump(const std::string& name_part) {
+    std::string s;
+    for (const auto& [k, v] : Values(name_part))
+      s += "  " + k + " = " + v + "\n";
+    return s;
+  }
+
+ private:
+  void On(const diagnostic_msgs::DiagnosticArrayConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& st : msg->status) {
+      auto& m = latest_[st.name];
+      m.clear();
+      for (const auto& kv : st.values) m[kv.key] = kv.value;
+    }
+  }
+  std::mutex mutex_;
+  std::map<std::string, std::map<std::string, std::string>> latest_;
+  ros::Subscriber sub_;
+};
+
+// Waits (spinning in the background) until pred() or the timeout.
+template <typename Pred>
+bool WaitFor(Pred pred, double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    if (pred()) return true;
+    ros::WallDuration(0.1).sleep();
+  }
+  return pred();
+}
+
+inline PointCloud CloudFromMsg(const sensor_msgs::PointCloud2& msg) {
+  PointCloud c;
+  if (msg.width * msg.height == 0) return c;
+  sensor_msgs::PointCloud2ConstIterator<float> x(msg, "x"), y(msg, "y"),
+      z(msg, "z");
+  for (; x != x.end(); ++x, ++y, ++z) c.xyz.emplace_back(*x, *y, *z);
+  return c;
+}
+
+// Process id of a node (XML-RPC getPid), or -1.
+inline int NodePid(const std::string& node) {
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  args[1] = node;
+  if (!ros::master::execute("lookupNode", args, result, payload, false))
+    return -1;
+  std::string uri = payload;
+  std::string host;
+  uint32_t port = 0;
+  if (!ros::network::splitURI(uri, host, port)) return -1;
+  XmlRpc::XmlRpcClient client(host.c_str(), port, "/");
+  XmlRpc::XmlRpcValue a, r;
+  a[0] = ros::this_node::getName();
+  if (!client.execute("getPid", a, r)) return -1;
+  if (r.getType() != XmlRpc::XmlRpcValue::TypeArray || r.size() < 3) return -1;
+  return static_cast<int>(r[2]);
+}
+
+// Peak resident set size (VmHWM) of a process in MB, or -1.
+inline double PeakRssMb(int pid) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("VmHWM:", 0) == 0)
+      return std::atof(line.c_str() + 6) / 1024.0;
+  return -1;
+}
+
+// Runs `rosbag play` on `bag` in a background thread.
+inline std::thread PlayBag(const std::string& bag, double rate,
+                           const std::string& extra = "") {
+  const std::string cmd = "rosbag play --quiet -r " + std::to_string(rate) +
+                          " " + extra + " '" + bag + "' >/dev/null 2>&1";
+  return std::thread([cmd] {
+    if (std::system(cmd.c_str()) != 0) ROS_ERROR("failed: %s", cmd.c_str());
+  });
+}
+
+}  // namespace testing
+}  // namespace wild_mvs
