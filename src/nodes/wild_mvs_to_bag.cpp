@@ -20,8 +20,9 @@
 namespace {
 
 const char* kUsage =
-    "usage: wild_mvs_to_bag DATASET OUT.bag [--rate HZ] [--with-points]\n"
+    "usage: wild_mvs to-bag DATASET OUT.bag [--rate HZ] [--with-points]\n"
     "                       [--world-frame NAME] [--camera-frame NAME]\n"
+    "(the same as wild_mvs_to_bag DATASET OUT.bag ...)\n"
     "Writes the dataset's views as /camera/image_raw (rgb8),\n"
     "/camera/camera_info and /tf (world -> camera optical frame) at HZ\n"
     "frames per second (default 5), plus /sparse_points "
