@@ -288,13 +288,14 @@ std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::Prepare(
 }
 
 std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::GetMap(
-    int view) {
+    int view, bool required) {
   auto it = lru_index_.find(view);
   if (it != lru_index_.end()) {
     lru_.splice(lru_.begin(), lru_, it->second);
     return it->second->second;
   }
   std::shared_ptr<const DepthMap> m = depth_(view);
+  if (!m && !required) return nullptr;
   Require(m != nullptr,
           "fusion: the depth map provider returned no map for view ", view);
   ++stats_.map_loads;
@@ -490,7 +491,7 @@ void StreamingFusion::TrimPending() {
 
 void StreamingFusion::AddView(int view) {
   Require(!HasView(view), "fusion: view ", view, " was already added");
-  std::shared_ptr<const Prepared> v = GetMap(view);
+  std::shared_ptr<const Prepared> v = GetMap(view, true);
   const Prepared& V = *v;
   const int W = V.width, H = V.height;
   const size_t n = static_cast<size_t>(W) * H;
@@ -526,7 +527,8 @@ void StreamingFusion::AddView(int view) {
   std::vector<uint16_t> support(n, 1);
   const Camera& cv_cam = V.camera;
   for (int u : related) {
-    std::shared_ptr<const Prepared> um = GetMap(u);
+    std::shared_ptr<const Prepared> um = GetMap(u, false);
+    if (!um) continue;  // no longer available (e.g. a bounded ROS store)
     const Prepared& U = *um;
     parallel(H, [&](int r) {
       for (int c = 0; c < W; ++c) {

@@ -382,6 +382,33 @@ TEST(Fusion, RejectsMalformedInput) {
   EXPECT_THROW(d.AddView(1), Error);
   for (const auto& p : d.Cloud().xyz) EXPECT_TRUE(p.allFinite());
   EXPECT_THROW(StreamingFusion(FusionOptions(), nullptr), Error);
+  // A supporter that is no longer available gives no support; the view
+  // itself must exist. A malformed supporter leaves the fusion unchanged.
+  bool gone = false;
+  DepthMapProvider store = [&gone, base = prov.Get()](int v) {
+    if (gone && v == 0) return std::shared_ptr<const DepthMap>();
+    return base(v);
+  };
+  FusionOptions tiny;
+  tiny.map_cache_mb = 0;  // force reloads
+  tiny.min_support = 2;
+  StreamingFusion e(tiny, store);
+  e.AddView(0);
+  gone = true;
+  EXPECT_NO_THROW(e.AddView(1));
+  EXPECT_THROW(e.AddView(0), Error);  // already added
+  StreamingFusion f(tiny, [&](int v) {
+    if (v == 0) return prov.Get()(v);
+    auto m = std::make_shared<DepthMap>(*prov.Get()(v));
+    m->confidence = cv::Mat(3, 3, CV_32F);
+    return std::shared_ptr<const DepthMap>(m);
+  });
+  f.AddView(0);
+  const size_t pending = f.stats().pending;
+  EXPECT_THROW(f.AddView(1), Error);
+  EXPECT_FALSE(f.HasView(1));
+  EXPECT_EQ(f.stats().pending, pending);
+  EXPECT_EQ(f.num_points(), 0u);
 }
 
 }  // namespace

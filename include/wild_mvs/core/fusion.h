@@ -30,7 +30,7 @@
 // grow with views x image size. A view is checked against the related views
 // added *before* it. Choice for earlier samples that gain support from a
 // later view: samples with too little support are kept as compact *pending*
-// samples (world position, normal, colour; ~48 bytes each, not the map) in a
+// samples (world position, normal, colour; 64 bytes each, not the map) in a
 // structure bounded by pending_mb (the oldest views' pending samples are
 // dropped first). When view v is added, the pending samples of v's related
 // views are re-checked against v and promoted into the cloud when they reach
@@ -102,7 +102,11 @@ struct FusionOptions {
   void Check() const;
 };
 
-// view -> its depth map (may load from disk). Must not return nullptr.
+// view -> its depth map (may load from disk). For the view being added it
+// must return a map (nullptr is an Error); for an earlier view it may return
+// nullptr when that map is no longer available (a bounded store): the view
+// then just gives no support. Exceptions propagate; AddView leaves the
+// fusion unchanged when the provider throws.
 using DepthMapProvider =
     std::function<std::shared_ptr<const DepthMap>(int view)>;
 // view -> linear RGB CV_32FC3 image (any size; resized to the map when it
@@ -141,11 +145,15 @@ class StreamingFusion {
   // Adds one view's depth map: checks it against the related views added
   // before, re-checks their pending samples against it, and merges accepted
   // samples. Throws Error when the view was already added or its map is
-  // malformed (sizes, types, camera).
+  // malformed (sizes, types, camera, mask, image); the fusion is then
+  // unchanged (all loading and checks happen before any update).
   void AddView(int view);
   bool HasView(int view) const;
 
-  // The current cloud (colours converted to sRGB for display).
+  // The current cloud: xyz, unit normal, confidence (mean of the samples),
+  // support; rgb (sRGB for display, converted from the linear mean) only
+  // when an image provider was given. Point order = creation order
+  // (deterministic).
   PointCloud Cloud() const;
   size_t num_points() const;
   size_t peak_bytes() const { return stats_.peak_bytes; }
@@ -158,7 +166,7 @@ class StreamingFusion {
   struct Pending;
   struct Accum;
   struct Sample;
-  std::shared_ptr<const Prepared> GetMap(int view);
+  std::shared_ptr<const Prepared> GetMap(int view, bool required);
   std::shared_ptr<const Prepared> Prepare(int view, const DepthMap& m);
   std::vector<int> RelatedViews(int view, const Prepared& map) const;
   void Insert(const Sample& s);
