@@ -9,6 +9,7 @@
 #include <wild_mvs/SaveCloud.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -40,6 +41,10 @@ TEST(Pipeline, BagThroughDepthAndFusionNodes) {
       scene.scene, [&](int i) { return ros1::LinearToSrgb8(scene.images[i]); },
       bag, bo);
 
+  // WILD_MVS_KEEP_BAG=PATH keeps a copy of the bag (demos, screenshots).
+  if (const char* keep = std::getenv("WILD_MVS_KEEP_BAG"))
+    std::filesystem::copy_file(
+        bag, keep, std::filesystem::copy_options::overwrite_existing);
   std::mutex mutex;
   std::map<int, sensor_msgs::ImageConstPtr> depth;  // by view index
   std::map<int, wild_mvs::DepthViewConstPtr> views;
