@@ -1,11 +1,6 @@
 // Copyright wild_mvs authors.
 #include "wild_mvs/cli/option_set.h"
 
-// GCC 12 reports a false -Wdangling-pointer inside yaml-cpp 0.7's inlined
-// Node accessors (yaml-cpp issue 1155); the code is correct.
-#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
-#pragma GCC diagnostic ignored "-Wdangling-pointer"
-#endif
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
