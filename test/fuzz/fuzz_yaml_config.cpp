@@ -6,6 +6,7 @@
 // that loads and passes Check() must survive ToYaml -> load again with the
 // same values.
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include "wild_mvs/cli/option_set.h"
@@ -32,6 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     options2.LoadYamlString(yaml, "round trip");
     again.Check();
   } catch (const Error& e) {
+    std::fprintf(stderr, "round trip failed: %s\n", e.what());
     __builtin_trap();  // the tool's own output must load
   }
   if (options2.ToYaml(false) != options.ToYaml(false)) __builtin_trap();

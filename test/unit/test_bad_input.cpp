@@ -8,17 +8,20 @@
 
 #include <csignal>
 #include <filesystem>
-#include <iostream>
 #include <fstream>
+#include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <sstream>
 #include <string>
 
+#include "synthetic_scene.h"
 #include "test_paths.h"
+#include "wild_mvs/cli/scene_setup.h"
 #include "wild_mvs/core/camera.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/colmap.h"
@@ -269,6 +272,56 @@ TEST_F(BadInput, TruncatedOrCorruptBinaryModel) {
   WriteText(dir_ + "/cameras.bin", bytes);
   WriteText(dir_ + "/images.bin", std::string(8, '\0'));
   ExpectError([&] { ReadColmapBinary(dir_); }, {"cameras\\.bin", "byte"});
+}
+
+// --- geometry the algorithm cannot use ---------------------------------
+TEST_F(BadInput, AllViewsFromOnePosition) {
+  // Pure rotation / one tripod position: no parallax anywhere. No crash and
+  // no invented depth: every view gets an empty depth map and the report
+  // (log/<view>.json) says why.
+  testing::SyntheticSpec spec = testing::SlantedPlaneSpec(20, 4);
+  spec.width = 64;
+  spec.height = 48;
+  spec.focal = 60;
+  spec.num_sparse_points = 60;
+  spec.supersample = 1;
+  for (Eigen::Vector3d& c : spec.camera_centers) c = spec.camera_centers[0];
+  const testing::SyntheticScene s = testing::Render(spec);
+  ImageCache cache(s.Loader(), 64);
+  for (int ref = 0; ref < 2; ++ref) {
+    ViewReport report;
+    const DepthMap dm =
+        ReconstructView(s.scene, ref, cache, MvsOptions(), nullptr, &report);
+    EXPECT_EQ(dm.CountValid(), 0) << "view " << ref;
+    ASSERT_FALSE(report.fallbacks.empty());
+    bool said_why = false;
+    for (const std::string& f : report.fallbacks) {
+      std::cout << "  -> " << f << "\n";
+      said_why = said_why || f.find("0 neighbours") != std::string::npos ||
+                 f.find("no usable neighbour") != std::string::npos;
+    }
+    EXPECT_TRUE(said_why);
+  }
+}
+
+TEST_F(BadInput, ImageTooLargeIsDownscaledWithItsCamera) {
+  // --max-image-size (image.max_image_size): the camera is scaled and the
+  // image downscaled at load; the tool prints how many views were scaled.
+  Scene scene;
+  scene.views = {MakeView(dir_, 200, 100)};
+  ASSERT_TRUE(cv::imwrite(scene.views[0].image_path, Pattern(200, 100)));
+  EXPECT_EQ(cli::LimitImageSize(&scene, 50), 1);
+  const View& v = scene.views[0];
+  EXPECT_EQ(v.camera.width, 50);
+  EXPECT_EQ(v.camera.height, 25);
+  EXPECT_NEAR(v.camera.fx, 25.0, 1e-9);
+  EXPECT_EQ(v.file_width, 200);
+  const cv::Mat img = LoadViewImage(v, ImageOptions());
+  EXPECT_EQ(img.cols, 50);
+  EXPECT_EQ(img.rows, 25);
+  cli::LimitImageSize(&scene, 50);  // idempotent
+  EXPECT_EQ(scene.views[0].camera.width, 50);
+  EXPECT_EQ(scene.views[0].camera.height, 25);
 }
 
 // --- depth maps ------------------------------------------------------------
