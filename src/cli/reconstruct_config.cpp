@@ -78,6 +78,10 @@ void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
   set->Add("tracker.features.downscale", &f.downscale,
            "detect features on the image shrunk by this factor (>= 1)", 1,
            kInf);
+  set->Add("tracker.features.max_image_size", &f.max_image_size,
+           "detect features on images shrunk to this longest side, 0 = no "
+           "limit",
+           0, kIntMax);
   set->Add("tracker.features.srgb_encode", &f.srgb_encode,
            "sRGB-encode the grey image before SIFT");
   set->Add("tracker.features.root_sift", &f.root_sift,
@@ -107,6 +111,13 @@ void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
   set->Add(
       "tracker.min_triangulation_angle_deg", &t.min_triangulation_angle_deg,
       "a point's largest pairwise viewing angle must reach this (deg)", 0, 180);
+  set->Add("tracker.max_scale_ratio", &t.max_scale_ratio,
+           "feature scales of a track may differ by at most this factor, "
+           "0 = off",
+           0, kInf);
+  set->Add("tracker.resolve_conflicts", &t.resolve_conflicts,
+           "keep the best feature of a view with two in one track (else "
+           "reject the track)");
   set->Add("tracker.min_track_length", &t.min_track_length,
            "tracks seen in fewer views produce no point", 2, kIntMax);
   set->Add("tracker.refine_iterations", &t.refine_iterations,
