@@ -8,8 +8,14 @@ export ROS_MASTER_URI=${ROS_MASTER_URI:-http://localhost:11311}
 BUILD_DIR="${BUILD_DIR:-$WILD_MVS_ROOT/build}"
 JOBS="${JOBS:-$(nproc)}"
 
+# ccache, when installed, makes rebuilds and other checkouts cheap.
+CCACHE_ARGS=()
+if command -v ccache >/dev/null 2>&1; then
+  CCACHE_ARGS=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
+
 wild_mvs_build() {  # extra cmake args...
-  cmake -S "$WILD_MVS_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release \
+  cmake -S "$WILD_MVS_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${CCACHE_ARGS[@]}" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@" >"$BUILD_DIR.cmake.log" 2>&1 \
     || { cat "$BUILD_DIR.cmake.log"; return 1; }
   cmake --build "$BUILD_DIR" -j"$JOBS"
