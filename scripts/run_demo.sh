@@ -2,12 +2,15 @@
 # The main job on the sample shipped in the repository: installs what is
 # missing (Debian 12 packages), builds, then runs wild_mvs on
 # data/templeSparseRing (16 views, Middlebury): info, sparse tracks from the
-# known poses, depth maps, fused point cloud and mesh; prints a summary.
+# known poses, depth maps, fused point cloud and mesh with the offline tool,
+# then the same sample through the ROS nodes (bag -> depth_node ->
+# fusion_node -> saved cloud); prints a summary.
 # Works from any current directory; re-running resumes finished views.
 #
-# Usage: scripts/run_demo.sh [--full] [--out DIR]
+# Usage: scripts/run_demo.sh [--full] [--no-ros] [--out DIR]
 #   --full     full resolution (640x480; several minutes on 2 cores)
 #              instead of 320x240
+#   --no-ros   only the offline tool (no ROS packages needed)
 #   --out DIR  output folder (default: build/demo)
 set -eo pipefail
 source "$(dirname "$0")/common.sh"
@@ -17,16 +20,23 @@ OUT="$BUILD_DIR/demo"
 while [ $# -gt 0 ]; do
   case "$1" in
     --full) SIZE=0 ;;
+    --no-ros) NO_ROS=1 ;;
     --out) OUT="$2"; shift ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "run_demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
 done
 
-bash "$WILD_MVS_ROOT/scripts/install_deps.sh"
-mkdir -p "$BUILD_DIR"
-wild_mvs_build
+if [ -n "${NO_ROS:-}" ]; then
+  bash "$WILD_MVS_ROOT/scripts/install_deps.sh" --no-ros
+  mkdir -p "$BUILD_DIR"
+  wild_mvs_build -DWILD_MVS_WITH_ROS=OFF
+else
+  bash "$WILD_MVS_ROOT/scripts/install_deps.sh"
+  mkdir -p "$BUILD_DIR"
+  wild_mvs_build -DWILD_MVS_WITH_ROS=ON
+fi
 WILD_MVS="$BUILD_DIR/bin/wild_mvs"
 DATA="$WILD_MVS_ROOT/data/templeSparseRing"
 mkdir -p "$OUT"
@@ -45,6 +55,12 @@ step "wild_mvs reconstruct (depth maps, fused cloud, mesh) -> $RUN"
 "$WILD_MVS" reconstruct "$DATA" "$RUN" --max-image-size "$SIZE" \
   | tee "$OUT/reconstruct_summary.txt"
 
+if [ -z "${NO_ROS:-}" ]; then
+  step "ROS pipeline: wild_mvs to-bag, rosbag play -> depth_node -> fusion_node -> $OUT/ros_$TAG/cloud.ply"
+  bash "$WILD_MVS_ROOT/scripts/ros_reconstruct.sh" "$DATA" "$OUT/ros_$TAG" 2 \
+    max_image_size:="$SIZE" | tee "$OUT/ros_summary.txt"
+fi
+
 step "demo summary"
 n_depth=$(ls "$RUN"/depth/*.pfm 2>/dev/null | wc -l)
 echo "binary:       $WILD_MVS"
@@ -53,3 +69,7 @@ echo "depth maps:   $n_depth views in $RUN/depth (normal/, confidence/, cameras/
 echo "point cloud:  $RUN/fused.ply"
 echo "mesh:         $RUN/mesh.ply"
 cat "$OUT/reconstruct_summary.txt"
+if [ -z "${NO_ROS:-}" ]; then
+  echo "ROS pipeline: bag $OUT/ros_$TAG/input.bag, cloud $OUT/ros_$TAG/cloud.ply"
+  grep -E "end-to-end|peak RSS|saved" "$OUT/ros_summary.txt" || true
+fi
