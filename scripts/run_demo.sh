@@ -22,7 +22,7 @@ while [ $# -gt 0 ]; do
     --full) SIZE=0 ;;
     --no-ros) NO_ROS=1 ;;
     --out) OUT="$2"; shift ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     *) echo "run_demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
