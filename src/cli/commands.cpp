@@ -23,6 +23,8 @@ const std::vector<Command>& AllCommands() {
        &RunMesh},
       {"eval", "score depth maps or a point cloud against ground truth",
        &RunEval},
+      {"render", "draw a cloud or mesh to a PNG (offscreen, z-buffered)",
+       &RunRender},
       {"to-bag", "write a dataset as a ROS bag (needs the ROS build)",
        &RunToBag},
   };

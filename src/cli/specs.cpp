@@ -151,5 +151,49 @@ CommandSpec EvalSpec() {
   return s;
 }
 
+CommandSpec RenderSpec() {
+  CommandSpec s;
+  s.name = "render";
+  s.usage = "IN.ply OUT.png [options]";
+  s.summary =
+      "Draws a point cloud (fused.ply) or a mesh (mesh.ply) offscreen and\n"
+      "writes a PNG (atomically): z-buffered square splats sized by the\n"
+      "sample spacing (in their colour; grey Lambert-shaded without colour)\n"
+      "or flat-shaded triangles with Lambert lighting from the viewer's\n"
+      "upper left. The view is a camera file of a reconstruct folder\n"
+      "(--camera OUT/cameras/S.txt, optionally refitted with --fit) or, by\n"
+      "default, fitted automatically: looking at the model's widest side,\n"
+      "up from the reconstruct folder's cameras (IN.ply's folder/cameras/)\n"
+      "or --up.";
+  s.positionals = {"IN.ply", "OUT.png"};
+  s.min_positionals = s.max_positionals = 2;
+  s.flags = {
+      {"camera", "FILE",
+       "view from this camera file (OUT/cameras/S.txt), scaled to --width", ""},
+      {"fit", "",
+       "with --camera: keep its orientation, place the camera so that the "
+       "model fills the image",
+       ""},
+      {"width", "N", "image width in pixels (default 800)", ""},
+      {"height", "N",
+       "image height (default: the camera's aspect, or 3/4 of the width)", ""},
+      {"hfov", "DEG", "horizontal field of view of fitted views (default 40)",
+       ""},
+      {"up", "X,Y,Z", "world up direction of the automatic view", ""},
+      {"roll", "DEG",
+       "turn the view counter-clockwise about its axis (90: sideways "
+       "photos upright; the picture's sides swap)",
+       ""},
+      {"points", "", "draw a mesh's vertices as points", ""},
+      {"point-size", "S",
+       "splat side in world units (default: 1.5 x median spacing)", ""},
+      {"max-splat", "PX", "largest splat side in pixels (default 12)", ""},
+      {"shade", "", "Lambert-shade coloured points too", ""},
+      {"mesh-colors", "", "colour mesh faces by their vertex colours", ""},
+      {"supersample", "N", "anti-aliasing factor (default 2)", ""},
+  };
+  return s;
+}
+
 }  // namespace cli
 }  // namespace wild_mvs

@@ -90,11 +90,12 @@ cv::Mat NormalPreview(const cv::Mat& normal) {
   return out;
 }
 
-void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
+void WriteImageAtomically(const std::string& path, const cv::Mat& image,
+                          const std::vector<int>& params) {
   Require(!image.empty(), path, ": cannot write an empty image");
   ProduceFileAtomically(path, [&](const std::string& tmp) {
     try {
-      return cv::imwrite(tmp, image);
+      return cv::imwrite(tmp, image, params);
     } catch (const cv::Exception& e) {
       throw Error(Msg(path, ": cannot write image: ", e.what()));
     }

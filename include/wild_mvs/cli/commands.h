@@ -29,6 +29,7 @@ int RunReconstruct(const CommandArgs& args);
 int RunFuse(const CommandArgs& args);
 int RunMesh(const CommandArgs& args);
 int RunEval(const CommandArgs& args);
+int RunRender(const CommandArgs& args);
 int RunToBag(const CommandArgs& args);
 
 // Folder of the running executable (for sibling tools such as

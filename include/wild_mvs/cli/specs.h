@@ -12,6 +12,7 @@ CommandSpec SparseSpec();
 CommandSpec FuseSpec();
 CommandSpec MeshSpec();
 CommandSpec EvalSpec();
+CommandSpec RenderSpec();
 
 // The dataset flags shared by info, sparse and reconstruct.
 std::vector<FlagSpec> DatasetFlags();

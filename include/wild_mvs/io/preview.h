@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 namespace wild_mvs {
 
@@ -20,8 +21,10 @@ cv::Mat ConfidencePreview(const cv::Mat& confidence);
 // colour: R = (1 + nx) / 2, G = (1 + ny) / 2, B = (1 + nz) / 2 (x 255).
 cv::Mat NormalPreview(const cv::Mat& normal);
 
-// cv::imwrite through a temporary file and rename (atomic). Throws Error
-// naming the path when it fails.
-void WriteImageAtomically(const std::string& path, const cv::Mat& image);
+// cv::imwrite through a temporary file and rename (atomic), with optional
+// cv::imwrite parameters (e.g. {cv::IMWRITE_PNG_COMPRESSION, 9}). Throws
+// Error naming the path when it fails.
+void WriteImageAtomically(const std::string& path, const cv::Mat& image,
+                          const std::vector<int>& params = {});
 
 }  // namespace wild_mvs
