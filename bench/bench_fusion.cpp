@@ -33,6 +33,13 @@ using namespace wild_mvs;  // NOLINT
 
 namespace {
 
+double CpuSeconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec +
+         1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
 double PeakRssMb() {
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
@@ -120,6 +127,7 @@ int Run(int argc, char** argv) {
   const double rss_before = PeakRssMb();
   ThreadPool pool(threads);
   FusionStats stats;
+  const double cpu0 = CpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
   const PointCloud cloud =
       FuseDepthMaps(views, options, provider, nullptr, nullptr,
@@ -127,12 +135,14 @@ int Run(int argc, char** argv) {
   const double secs =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
           .count();
+  const double cpu = CpuSeconds() - cpu0;
   std::printf(
-      "views %d  time %.2f s (%.3f s/view)  points %zu  samples %zu  "
+      "views %d  time %.2f s (%.3f s/view)  cpu %.2f s  points %zu  samples "
+      "%zu  "
       "accepted %zu  promoted %zu  pending_dropped %zu  map_loads %zu\n"
       "memory: fusion peak %.1f MB (held maps peak %.1f MB, cloud %.1f MB, "
       "pending %.1f MB)  process peak RSS %.1f MB (%.1f MB before fusion)\n",
-      stats.views, secs, secs / std::max(1, stats.views), cloud.size(),
+      stats.views, secs, secs / std::max(1, stats.views), cpu, cloud.size(),
       stats.samples, stats.accepted, stats.promoted, stats.pending_dropped,
       stats.map_loads, stats.peak_bytes / 1048576.0,
       stats.peak_held_map_bytes / 1048576.0, stats.cloud_bytes / 1048576.0,
