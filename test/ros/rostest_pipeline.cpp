@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
+#include <visualization_msgs/Marker.h>
 #include <wild_mvs/DepthView.h>
 #include <wild_mvs/SaveCloud.h>
 
@@ -66,6 +67,12 @@ TEST(Pipeline, BagThroughDepthAndFusionNodes) {
       "/fusion_node/cloud", 2, [&](const sensor_msgs::PointCloud2ConstPtr& m) {
         std::lock_guard<std::mutex> lock(mutex);
         cloud = m;
+      });
+  visualization_msgs::MarkerConstPtr mesh;
+  ros::Subscriber s4 = nh.subscribe<visualization_msgs::Marker>(
+      "/fusion_node/mesh", 2, [&](const visualization_msgs::MarkerConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        mesh = m;
       });
   DiagnosticsWatch diag(nh);
   ros::AsyncSpinner spinner(2);
@@ -140,6 +147,45 @@ TEST(Pipeline, BagThroughDepthAndFusionNodes) {
   EXPECT_GT(cm.precision[1], 0.9) << cm.ToString();
   EXPECT_GT(cm.recall[1], 0.3) << cm.ToString();
 
+  // The mesh Marker (mesh_period 2 s, Poisson on the fused cloud): a
+  // triangle list in the world frame whose triangles are finite,
+  // non-degenerate and lie on the scene (centroids vs the GT surface).
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return mesh != nullptr;
+      },
+      30))
+      << "no mesh on /fusion_node/mesh";
+  size_t triangles = 0, degenerate = 0;
+  PointCloud centroids;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    EXPECT_EQ(mesh->type, visualization_msgs::Marker::TRIANGLE_LIST);
+    EXPECT_EQ(mesh->action, visualization_msgs::Marker::ADD);
+    EXPECT_EQ(mesh->header.frame_id, "world");
+    EXPECT_DOUBLE_EQ(mesh->pose.orientation.w, 1.0);
+    ASSERT_EQ(mesh->points.size() % 3, 0u);
+    EXPECT_TRUE(mesh->colors.empty() ||
+                mesh->colors.size() == mesh->points.size());
+    triangles = mesh->points.size() / 3;
+    for (size_t t = 0; t < triangles; ++t) {
+      Eigen::Vector3d p[3];
+      for (int k = 0; k < 3; ++k) {
+        const auto& q = mesh->points[3 * t + k];
+        p[k] = Eigen::Vector3d(q.x, q.y, q.z);
+        ASSERT_TRUE(p[k].allFinite()) << "triangle " << t;
+      }
+      if ((p[1] - p[0]).cross(p[2] - p[0]).norm() < 1e-12) ++degenerate;
+      centroids.xyz.push_back(((p[0] + p[1] + p[2]) / 3).cast<float>());
+    }
+  }
+  EXPECT_GT(triangles, 500u);
+  EXPECT_LT(degenerate, triangles / 100 + 1);
+  const CloudMetrics mm =
+      EvaluateCloud(centroids, scene.GroundTruthCloud(1), co);
+  EXPECT_GT(mm.precision[1], 0.7) << "mesh: " << mm.ToString();
+
   // ~save writes a valid binary PLY atomically.
   wild_mvs::SaveCloud srv;
   srv.request.path = dir + "/saved.ply";
@@ -179,10 +225,11 @@ TEST(Pipeline, BagThroughDepthAndFusionNodes) {
   std::printf(
       "[pipeline] %d views at %.1f Hz: bag played in %.1f s, depth maps "
       "after %.1f s; %zu fused points; precision@4cm %.3f recall@4cm %.3f; "
+      "mesh %zu triangles, centroid precision@4cm %.3f; "
       "peak RSS depth_node %.0f MB, fusion_node %.0f MB; mean %.2f s per "
       "depth map\n",
       kViews, kRate, play_seconds, depth_seconds, fused.size(), cm.precision[1],
-      cm.recall[1], depth_rss, fusion_rss,
+      cm.recall[1], triangles, mm.precision[1], depth_rss, fusion_rss,
       std::atof(
           diag.Values("depth_node")["mean seconds per depth map"].c_str()));
   std::filesystem::remove_all(dir);
