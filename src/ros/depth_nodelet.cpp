@@ -101,8 +101,8 @@ struct DepthNode::Impl {
     }
     cv.notify_all();
     if (dropped)
-      Drop(Topic(options.image_transport == "raw" ? "image"
-                                                  : "image/compressed"),
+      Drop(Topic("image") +
+               (options.image_transport == "raw" ? "" : "/compressed"),
            "input queue full (frames arrive faster than they are processed)");
   }
 
@@ -121,8 +121,11 @@ struct DepthNode::Impl {
     Enqueue(std::move(f));
   }
   void OnInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex);
-    latest_info = msg;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      latest_info = msg;
+    }
+    cv.notify_all();
   }
   void OnPose(const geometry_msgs::PoseStampedConstPtr& msg) {
     {
@@ -226,8 +229,18 @@ struct DepthNode::Impl {
     return true;
   }
 
-  void Process(const Frame& f) {
-    const std::string image_topic = Topic(f.raw ? "image" : "image/compressed");
+  void Process(Frame f) {
+    const std::string image_topic =
+        Topic("image") + (f.raw ? "" : "/compressed");
+    if (!f.info) {
+      // The very first image may come before the first camera_info (other
+      // connection): wait for one as long as for a pose.
+      const auto deadline = std::chrono::steady_clock::now() +
+                            std::chrono::duration<double>(options.tf_timeout);
+      std::unique_lock<std::mutex> lock(mutex);
+      cv.wait_until(lock, deadline, [this] { return stop || latest_info; });
+      f.info = latest_info;
+    }
     if (!f.info) {
       Drop(Topic("camera_info"), "no camera_info received yet");
       return;
@@ -430,8 +443,10 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     m.image_sub = m.it->subscribe("image", 5, &Impl::OnImage, &m,
                                   image_transport::TransportHints("raw"));
   } else {
-    m.compressed_sub =
-        m.nh.subscribe("image/compressed", 5, &Impl::OnCompressed, &m);
+    // <image>/compressed, as image_transport names it: "image" is
+    // remapped as a whole name, so resolve it before appending.
+    m.compressed_sub = m.nh.subscribe(m.nh.resolveName("image") + "/compressed",
+                                      5, &Impl::OnCompressed, &m);
   }
 
   m.updater = std::make_unique<diagnostic_updater::Updater>(

@@ -1,8 +1,10 @@
 // Copyright wild_mvs authors.
 #include "wild_mvs/ros/scene_bag.h"
 
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <rosbag/bag.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_msgs/TFMessage.h>
 #include <wild_mvs/SparsePoints.h>
@@ -10,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/image.h"
@@ -71,6 +75,13 @@ void WriteSceneBag(const Scene& scene,
       tf2_msgs::TFMessage tf;
       tf.transforms.push_back(T);
       bag.write("/tf", t, tf);
+      if (options.with_pose) {
+        geometry_msgs::PoseStamped ps;
+        ps.header.stamp = t;
+        ps.header.frame_id = options.world_frame;
+        ps.pose = p;
+        bag.write(options.pose_topic, t, ps);
+      }
 
       sensor_msgs::CameraInfo info = CameraInfoFromCamera(v.camera);
       info.header.stamp = t;
@@ -82,17 +93,34 @@ void WriteSceneBag(const Scene& scene,
                   img.rows == v.camera.height,
               "to-bag: image of view '", v.name, "' is not ", v.camera.width,
               "x", v.camera.height, " 8-bit RGB");
-      sensor_msgs::Image im;
-      im.header = info.header;
-      im.width = img.cols;
-      im.height = img.rows;
-      im.encoding = sensor_msgs::image_encodings::RGB8;
-      im.step = img.cols * 3;
-      im.data.resize(static_cast<size_t>(im.step) * im.height);
-      for (int r = 0; r < img.rows; ++r)
-        std::memcpy(&im.data[static_cast<size_t>(r) * im.step], img.ptr(r),
-                    im.step);
-      bag.write(options.image_topic, t, im);
+      if (!options.compression.empty()) {
+        sensor_msgs::CompressedImage cm;
+        cm.header = info.header;
+        cv::Mat bgr;
+        cv::cvtColor(img, bgr, cv::COLOR_RGB2BGR);
+        std::vector<int> params;
+        if (options.compression == "jpeg")
+          params = {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality};
+        const std::string ext = options.compression == "png" ? ".png" : ".jpg";
+        Require(cv::imencode(ext, bgr, cm.data, params),
+                "to-bag: cannot encode view '", v.name, "' as ",
+                options.compression);
+        // image_transport's "compressed" format string.
+        cm.format = "rgb8; " + options.compression + " compressed bgr8";
+        bag.write(options.image_topic + "/compressed", t, cm);
+      } else {
+        sensor_msgs::Image im;
+        im.header = info.header;
+        im.width = img.cols;
+        im.height = img.rows;
+        im.encoding = sensor_msgs::image_encodings::RGB8;
+        im.step = img.cols * 3;
+        im.data.resize(static_cast<size_t>(im.step) * im.height);
+        for (int r = 0; r < img.rows; ++r)
+          std::memcpy(&im.data[static_cast<size_t>(r) * im.step], img.ptr(r),
+                      im.step);
+        bag.write(options.image_topic, t, im);
+      }
 
       if (options.with_points) {
         wild_mvs::SparsePoints sp;

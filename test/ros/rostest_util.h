@@ -121,8 +121,9 @@ inline double PeakRssMb(int pid) {
 // Runs `rosbag play` on `bag` in a background thread.
 inline std::thread PlayBag(const std::string& bag, double rate,
                            const std::string& extra = "") {
+  // `extra` after the bag: --topics takes every argument that follows it.
   const std::string cmd = "rosbag play --quiet -r " + std::to_string(rate) +
-                          " " + extra + " '" + bag + "' >/dev/null 2>&1";
+                          " '" + bag + "' " + extra + " >/dev/null 2>&1";
   return std::thread([cmd] {
     if (std::system(cmd.c_str()) != 0) ROS_ERROR("failed: %s", cmd.c_str());
   });

@@ -8,6 +8,11 @@
 //   /camera/camera_info  sensor_msgs/CameraInfo (ROS pixel convention, no
 //                        distortion: images are undistorted)
 //   /camera/image_raw    sensor_msgs/Image rgb8 (sRGB, as the camera gives)
+//   /camera/image_raw/compressed  sensor_msgs/CompressedImage instead of
+//                        the raw image when compression is "png" / "jpeg"
+//                        (the image_transport "compressed" topic)
+//   /camera/pose         geometry_msgs/PoseStamped (with_pose): the same
+//                        pose as /tf (camera optical frame in the world)
 //   /sparse_points       wild_mvs/SparsePoints (with_points): the scene's
 //                        points seen by >= 2 of the views so far, with their
 //                        observations by stamp (ROS pixel convention)
@@ -31,6 +36,10 @@ struct SceneBagOptions {
   std::string image_topic = "/camera/image_raw";
   std::string info_topic = "/camera/camera_info";
   std::string points_topic = "/sparse_points";
+  std::string compression;  // "" = raw rgb8, "png" or "jpeg" (compressed)
+  int jpeg_quality = 95;
+  bool with_pose = false;  // also write pose_topic (PoseStamped)
+  std::string pose_topic = "/camera/pose";
   void Check() const;
 };
 
