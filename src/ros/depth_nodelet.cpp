@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <mutex>
 #include <opencv2/calib3d.hpp>
@@ -332,6 +333,7 @@ struct DepthNode::Impl {
     auto view = boost::make_shared<wild_mvs::DepthView>();
     view->header = header;
     view->keyframe_id = r.keyframe_id;
+    view->session = ros::Time(r.session);
     view->neighbor_ids = r.neighbor_ids;
     for (double s : r.neighbor_stamps)
       view->neighbor_stamps.push_back(ros::Time(s));
@@ -392,6 +394,7 @@ struct DepthNode::Impl {
     stat.add("reconstructions failed", s.failed);
     stat.add("keyframes evicted before reconstruction", s.evicted_waiting);
     stat.add("stream resets", s.resets);
+    stat.addf("session", "%.6f", s.session);  // stamp that started it
     stat.add("sparse points", s.sparse_points);
     stat.add("last seconds per depth map", s.last_seconds);
     stat.add("mean seconds per depth map", s.mean_seconds);
@@ -478,6 +481,15 @@ DepthNode::~DepthNode() {
   if (m.frontend.joinable()) m.frontend.join();
   m.image_sub.shutdown();
   m.compressed_sub.shutdown();
+  const StreamStats s = m.stream->Stats();
+  std::fprintf(stderr,
+               "depth node: %lu frames received, %lu keyframes, %lu depth "
+               "maps, %lu frames dropped, %lu stream resets\n",
+               static_cast<unsigned long>(m.received),
+               static_cast<unsigned long>(s.keyframes_total),
+               static_cast<unsigned long>(s.reconstructed),
+               static_cast<unsigned long>(m.drops.Total()),
+               static_cast<unsigned long>(s.resets));
   m.stream.reset();
 }
 

@@ -19,6 +19,7 @@
 #include <map>
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
+#include <set>
 #include <thread>
 
 #include "wild_mvs/core/error.h"
@@ -44,6 +45,7 @@ struct FusionNode::Impl {
     DepthMap map;
     cv::Mat image;  // linear RGB at the map's size (may be empty)
     uint32_t keyframe_id = 0;
+    uint64_t session = 0;  // DepthView.session (ns)
     std::vector<ros::Time> neighbor_stamps;
     ros::Time stamp;
     std::chrono::steady_clock::time_point arrived;
@@ -82,8 +84,11 @@ struct FusionNode::Impl {
   std::map<uint64_t, int> view_of_stamp;  // stamp (ns) -> view index
   std::map<uint64_t, Item> waiting;       // reorder buffer by stamp (ns)
   int64_t last_fused_id = -1;
+  int64_t current_session = -1;      // DepthView.session (ns) being fused
+  std::set<uint64_t> seen_sessions;  // every session fused so far
   int next_view = 0;
   uint64_t fused = 0, revisions_ignored = 0, spilled = 0, resets = 0;
+  uint64_t sessions = 0, session_saves = 0;
   uint64_t cloud_version = 0, published_version = 0, meshed_version = 0;
   double last_fuse_seconds = 0;
 
@@ -184,6 +189,7 @@ struct FusionNode::Impl {
       return;
     }
     item.keyframe_id = msg.keyframe_id;
+    item.session = msg.session.toNSec();
     item.neighbor_stamps = msg.neighbor_stamps;
     item.stamp = msg.header.stamp;
     item.arrived = std::chrono::steady_clock::now();
@@ -198,14 +204,18 @@ struct FusionNode::Impl {
   }
 
   // Fuses waiting views in stamp order: the oldest goes when it is the next
-  // keyframe id, or waited reorder_timeout.
+  // keyframe id of the current session, the first (id 0) of a new session,
+  // a late view of an earlier session, or waited reorder_timeout.
   void FuseReadyLocked() {
     const auto now = std::chrono::steady_clock::now();
     while (!waiting.empty()) {
       auto it = waiting.begin();
       Item& item = it->second;
+      const int64_t session = static_cast<int64_t>(item.session);
       const bool next =
-          static_cast<int64_t>(item.keyframe_id) == last_fused_id + 1;
+          session == current_session
+              ? static_cast<int64_t>(item.keyframe_id) == last_fused_id + 1
+              : (seen_sessions.count(item.session) || item.keyframe_id == 0);
       const double waited =
           std::chrono::duration<double>(now - item.arrived).count();
       if (!next && waited < options.reorder_timeout) break;
@@ -214,7 +224,57 @@ struct FusionNode::Impl {
     }
   }
 
+  // Forgets the cloud and every fused view (~reset, on_new_session reset).
+  void ClearLocked() {
+    NewFusion();
+    held.clear();
+    held_order.clear();
+    held_bytes = 0;
+    view_of_stamp.clear();
+    last_fused_id = -1;
+    ++cloud_version;
+  }
+
+  // The session policy (FusionNodeOptions::on_new_session) when the first
+  // view of a new depth-node session is fused.
+  void StartSessionLocked(uint64_t session) {
+    const bool had_views = !view_of_stamp.empty();
+    const uint64_t finished = sessions > 0 ? sessions - 1 : 0;  // its index
+    ++sessions;
+    if (options.on_new_session == "reset" && had_views) {
+      if (!options.output_path.empty()) {
+        std::string stem = options.output_path;
+        if (stem.size() > 4 && stem.compare(stem.size() - 4, 4, ".ply") == 0)
+          stem.resize(stem.size() - 4);
+        const std::string path =
+            stem + "_session" + std::to_string(finished) + ".ply";
+        try {
+          SaveCloudPly(path, fusion->Cloud());
+          ++session_saves;
+          ROS_INFO("%s: new depth session: saved the previous cloud to %s",
+                   pnh.getNamespace().c_str(), path.c_str());
+        } catch (const std::exception& e) {
+          ROS_ERROR("%s: saving the previous session's cloud failed: %s",
+                    pnh.getNamespace().c_str(), e.what());
+        }
+      }
+      ClearLocked();
+      ++resets;
+    }
+    current_session = static_cast<int64_t>(session);
+    seen_sessions.insert(session);
+    last_fused_id = -1;
+  }
+
   void FuseLocked(uint64_t key, Item item) {
+    if (static_cast<int64_t>(item.session) != current_session) {
+      if (!seen_sessions.count(item.session)) {
+        StartSessionLocked(item.session);
+      } else if (options.on_new_session == "reset") {
+        Drop("view of an earlier depth session after a cloud reset");
+        return;
+      }
+    }
     const int v = next_view++;
     view_of_stamp[key] = v;
     item.map.view = v;
@@ -223,7 +283,8 @@ struct FusionNode::Impl {
       auto n = view_of_stamp.find(s.toNSec());
       if (n != view_of_stamp.end()) item.map.neighbors.push_back(n->second);
     }
-    last_fused_id = item.keyframe_id;
+    if (static_cast<int64_t>(item.session) == current_session)
+      last_fused_id = item.keyframe_id;
     Hold(v, std::move(item.map), std::move(item.image));
     const auto t0 = std::chrono::steady_clock::now();
     try {
@@ -336,15 +397,9 @@ struct FusionNode::Impl {
   bool OnReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
     {
       std::lock_guard<std::mutex> lock(fusion_mutex);
-      NewFusion();
-      held.clear();
-      held_order.clear();
-      held_bytes = 0;
-      view_of_stamp.clear();
+      ClearLocked();
       waiting.clear();
-      last_fused_id = -1;
       ++resets;
-      ++cloud_version;
     }
     PublishCloud(true);
     res.success = true;
@@ -381,6 +436,8 @@ struct FusionNode::Impl {
     stat.add("depth maps spilled", spilled);
     stat.add("last seconds per view", last_fuse_seconds);
     stat.add("resets", resets);
+    stat.add("depth sessions", sessions);
+    stat.add("session clouds saved", session_saves);
     stat.add("views dropped", dropped);
     for (const auto& [reason, n] : drops.Counts())
       stat.add("dropped: " + reason, n);

@@ -149,6 +149,7 @@ std::vector<std::string> BindFusionNode(Binder& b, FusionNodeOptions* o) {
   b.Bind("error_throttle", &o->error_throttle);
   b.Bind("max_published_points", &o->max_published_points);
   b.Bind("reorder_timeout", &o->reorder_timeout);
+  b.Bind("on_new_session", &o->on_new_session);
   b.Bind("map_store_mb", &o->map_store_mb);
   b.Bind("spill_dir", &o->spill_dir);
   BindFusion(b, &o->fusion);
@@ -283,6 +284,8 @@ void FusionNodeOptions::Check() const {
           "max_published_points = ", max_published_points, " must be >= 0");
   Require(std::isfinite(reorder_timeout) && reorder_timeout >= 0,
           "reorder_timeout = ", reorder_timeout, " must be >= 0");
+  Require(on_new_session == "keep" || on_new_session == "reset",
+          "on_new_session = '", on_new_session, "' must be 'keep' or 'reset'");
   Require(std::isfinite(map_store_mb) && map_store_mb > 0,
           "map_store_mb = ", map_store_mb, " must be > 0");
   fusion.Check();

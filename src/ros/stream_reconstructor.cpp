@@ -80,6 +80,8 @@ void StreamReconstructor::ClearLocked() {
   stamped_points_.clear();
   in_flight_.clear();
   ++generation_;
+  next_id_ = 0;  // ids restart in the new session
+  session_ = -1;
   have_last_center_ = false;
   if (options_.use_tracker)
     tracker_ = std::make_unique<SparseTracker>(options_.tracker, nullptr);
@@ -129,6 +131,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     last_stamp_ = stamp;
     last_center_ = center;
     have_last_center_ = true;
+    if (session_ < 0) session_ = stamp;
     if (!store_.IsNewKeyframe(camera, options_.keyframes))
       return FrameStatus::kNotKeyframe;
 
@@ -304,6 +307,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   Snapshot snap;
   KeyframePtr kf;
   int ref = -1;
+  double session = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (stopping_ || generation != generation_) {
@@ -321,9 +325,11 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     snap = MakeSnapshotLocked();
     for (size_t i = 0; i < snap.keyframes.size(); ++i)
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
+    session = session_;
   }
   StreamResult result;
   result.keyframe_id = id;
+  result.session = session;
   result.stamp = kf->stamp;
   result.frame_id = kf->frame_id;
   result.image = kf->image;
@@ -393,6 +399,7 @@ StreamStats StreamReconstructor::Stats() const {
   s.pending = static_cast<int>(in_flight_.size());
   s.waiting = ready_waiting_;
   s.sparse_points = points_.size() + stamped_points_.size();
+  s.session = session_;
   return s;
 }
 

@@ -99,6 +99,7 @@ TEST(StreamReconstructor, DepthMapsMatchGroundTruth) {
     for (uint32_t n : r.neighbor_ids) EXPECT_NE(n, r.keyframe_id);
     const int v = static_cast<int>(r.keyframe_id);
     EXPECT_DOUBLE_EQ(r.stamp, double(v));
+    EXPECT_DOUBLE_EQ(r.session, 0.0);  // stamp of the stream's first frame
     const DepthMetrics m = EvaluateDepth(r.depth.depth, r.depth.camera,
                                          s.depth[v], s.scene.views[v].camera);
     EXPECT_GT(m.completeness, 0.5) << "keyframe " << v << ": " << m.ToString();
@@ -131,7 +132,9 @@ TEST(StreamReconstructor, KeyframeSelectionOrderAndResets) {
   StreamReconstructor stream(o, c.OnResult(), c.OnError());
   using S = StreamReconstructor::FrameStatus;
   const Camera& c0 = s.scene.views[0].camera;
+  EXPECT_EQ(stream.Stats().session, -1.0);  // no frame yet
   EXPECT_EQ(stream.AddFrame(10.0, "cam", c0, s.images[0]), S::kKeyframe);
+  EXPECT_EQ(stream.Stats().session, 10.0);  // the first frame starts it
   // Same pose again: not a keyframe.
   EXPECT_EQ(stream.AddFrame(10.1, "cam", c0, s.images[0]), S::kNotKeyframe);
   // Older stamp (small step back): out of order, dropped.
@@ -144,11 +147,14 @@ TEST(StreamReconstructor, KeyframeSelectionOrderAndResets) {
   EXPECT_EQ(stream.AddFrame(1.0, "cam", s.scene.views[2].camera, s.images[2]),
             S::kReset);
   EXPECT_EQ(stream.Stats().keyframes, 1u);
+  EXPECT_EQ(stream.Stats().session, 1.0);  // a new session at the reset
+  EXPECT_EQ(stream.Stats().keyframes_total, 3u);
   // Pose jump of 50 m within 1 s: reset.
   Camera far = s.scene.views[3].camera;
   far.t += Eigen::Vector3d(50, 0, 0);
   EXPECT_EQ(stream.AddFrame(1.1, "cam", far, s.images[3]), S::kReset);
   EXPECT_EQ(stream.Stats().resets, 2u);
+  EXPECT_EQ(stream.Stats().session, 1.1);
   // Invalid camera / image: Error, state untouched.
   Camera bad = c0;
   bad.fx = 0;

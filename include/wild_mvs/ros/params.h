@@ -100,6 +100,14 @@ struct FusionNodeOptions {
   // Fusion is done in keyframe-id order: a view waits at most this long (s)
   // for a missing earlier keyframe (several workers deliver out of order).
   double reorder_timeout = 2.0;
+  // What a new depth-node session (DepthView.session: the depth node reset
+  // on a bag loop or pose jump, or was restarted) does to the cloud:
+  // "keep" = fuse it into the same cloud (the world frame is the same);
+  // "reset" = save the cloud so far to <output_path stem>_session<N>.ply
+  // (when output_path is set) and start a new cloud (the world frame was
+  // redefined, e.g. a SLAM map reset). Views of an earlier session that
+  // arrive late are fused ("keep") or dropped, counted ("reset").
+  std::string on_new_session = "keep";
   // Depth maps held in memory for the consistency checks; older ones are
   // spilled to spill_dir (a temporary folder when empty) and read back when
   // needed, so memory stays bounded on long runs.

@@ -76,7 +76,13 @@ struct StreamOptions {
 
 // One reconstructed keyframe.
 struct StreamResult {
-  uint32_t keyframe_id = 0;
+  uint32_t keyframe_id = 0;  // 0, 1, ... within the session
+  // Stamp of the first frame of the stream session the keyframe belongs to.
+  // A session starts with the first frame and again after every reset
+  // (time or pose jump, Reset()); keyframe ids restart at 0. Depth maps
+  // never use keyframes of another session. Workers fed the same stream
+  // agree on sessions and ids; a restarted node starts a new session.
+  double session = 0;
   double stamp = 0;
   std::string frame_id;
   int revision = 0;                     // 0 first time, then 1, 2 ...
@@ -103,6 +109,7 @@ struct StreamStats {
   uint64_t stale_results = 0;    // results discarded after a Reset
   uint64_t out_of_order = 0;     // frames with non-increasing stamps
   uint64_t resets = 0;
+  double session = -1;  // stamp that started the current session (-1: none)
   size_t sparse_points = 0;
   double last_seconds = 0, mean_seconds = 0;  // per depth map
 };
@@ -188,6 +195,7 @@ class StreamReconstructor {
   uint64_t generation_ = 0;
   double last_keyframe_wall_ = 0;  // steady clock, s
   double last_stamp_ = -1;
+  double session_ = -1;  // see StreamResult::session
   bool have_last_center_ = false;
   Eigen::Vector3d last_center_{0, 0, 0};
   StreamStats stats_;
