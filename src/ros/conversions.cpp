@@ -342,7 +342,10 @@ sensor_msgs::PointCloud2 CloudToMsg(const PointCloud& cloud,
   using PF = sensor_msgs::PointField;
   std::vector<std::pair<std::string, int>> fields = {
       {"x", PF::FLOAT32}, {"y", PF::FLOAT32}, {"z", PF::FLOAT32}};
-  if (cloud.has_rgb()) fields.push_back({"rgb", PF::FLOAT32});
+  // Always an "rgb" field (grey when the cloud has no colour): rviz picks
+  // its colour transformer from the first cloud it sees and keeps a
+  // fallback (flat white) when that one had no rgb, e.g. an empty cloud.
+  fields.push_back({"rgb", PF::FLOAT32});
   if (cloud.has_normal()) {
     fields.push_back({"normal_x", PF::FLOAT32});
     fields.push_back({"normal_y", PF::FLOAT32});
@@ -374,12 +377,13 @@ sensor_msgs::PointCloud2 CloudToMsg(const PointCloud& cloud,
     f[k++] = cloud.xyz[i].x();
     f[k++] = cloud.xyz[i].y();
     f[k++] = cloud.xyz[i].z();
-    if (cloud.has_rgb()) {
+    {
       auto c8 = [](float v) {
         return static_cast<uint32_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
       };
-      const uint32_t rgb = (c8(cloud.rgb[i].x()) << 16) |
-                           (c8(cloud.rgb[i].y()) << 8) | c8(cloud.rgb[i].z());
+      const Eigen::Vector3f c =
+          cloud.has_rgb() ? cloud.rgb[i] : Eigen::Vector3f::Constant(0.5f);
+      const uint32_t rgb = (c8(c.x()) << 16) | (c8(c.y()) << 8) | c8(c.z());
       std::memcpy(&f[k++], &rgb, 4);
     }
     if (cloud.has_normal()) {

@@ -296,6 +296,28 @@ TEST(Conversions, CloudToPointCloud2) {
   EXPECT_EQ(r[0], 0);
   sensor_msgs::PointCloud2 sub = CloudToMsg(cloud, 5);
   EXPECT_EQ(sub.width, 5u);
+  // rviz (RGB8 colour transformer) needs the packed float "rgb" field in
+  // every cloud, also an empty one or one without colours (grey).
+  for (const PointCloud& c : {PointCloud(), [] {
+                                PointCloud p;
+                                p.xyz.emplace_back(1, 2, 3);
+                                return p;
+                              }()}) {
+    const sensor_msgs::PointCloud2 m = CloudToMsg(c);
+    bool has_rgb = false;
+    for (const auto& f : m.fields)
+      if (f.name == "rgb" && f.datatype == sensor_msgs::PointField::FLOAT32 &&
+          f.count == 1 && f.offset == 12)
+        has_rgb = true;
+    EXPECT_TRUE(has_rgb);
+    EXPECT_EQ(m.point_step, 16u);
+    if (!c.empty()) {
+      sensor_msgs::PointCloud2ConstIterator<uint8_t> g(m, "rgb");
+      EXPECT_EQ(g[0], 128);
+      EXPECT_EQ(g[1], 128);
+      EXPECT_EQ(g[2], 128);
+    }
+  }
 }
 
 TEST(Conversions, DepthMapToCloudIsInWorldFrame) {
