@@ -2,7 +2,10 @@
 //
 //   bench_mvs MODEL_DIR IMAGES_DIR [--threads N] [--views i,j,...]
 //             [--max-image-size S] [--previews DIR] [--grey] [--no-lvs]
-//             [--no-normal] [--no-color-scale]
+//             [--no-normal] [--no-color-scale] [--save DIR]
+//
+// --save DIR writes each depth map with WriteDepthMapFiles (depth, normal,
+// confidence PFM, camera) for bench_depth_stats.
 //
 // Runs ReconstructView on each view (one view at a time, every thread of the
 // pool inside the view) and prints per view and in total: valid samples,
@@ -21,6 +24,7 @@
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/preview.h"
 
 using namespace wild_mvs;
@@ -35,13 +39,14 @@ int main(int argc, char** argv) {
   if (argc < 3) {
     std::cerr << "usage: bench_mvs MODEL_DIR IMAGES_DIR [--threads N] "
                  "[--views i,j] [--max-image-size S] [--previews DIR] "
-                 "[--grey] [--no-lvs] [--no-normal] [--no-color-scale]\n";
+                 "[--grey] [--no-lvs] [--no-normal] [--no-color-scale] "
+                 "[--min-views K] [--save DIR]\n";
     return 2;
   }
   try {
     int threads = 0;
     std::vector<int> views;
-    std::string previews;
+    std::string previews, save;
     MvsOptions opt;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
@@ -59,6 +64,8 @@ int main(int argc, char** argv) {
         opt.max_image_size = std::stoi(next());
       } else if (a == "--previews") {
         previews = next();
+      } else if (a == "--save") {
+        save = next();
       } else if (a == "--grey") {
         opt.use_color = false;
       } else if (a == "--no-lvs") {
@@ -101,6 +108,11 @@ int main(int argc, char** argv) {
         cv::imwrite(stem + "_depth.png", DepthPreview(dm.depth));
         cv::imwrite(stem + "_normal.png", NormalPreview(dm.normal));
         cv::imwrite(stem + "_confidence.png", ConfidencePreview(dm.confidence));
+      }
+      if (!save.empty()) {
+        std::vector<std::string> names;
+        for (int nb : dm.neighbors) names.push_back(scene.views[nb].name);
+        WriteDepthMapFiles(save, scene.views[v].Stem(), dm, names, false);
       }
       std::fflush(stdout);
     }
