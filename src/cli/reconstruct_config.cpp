@@ -192,6 +192,10 @@ void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
            "region growing tile side in pixels (parallel unit)", 1, kIntMax);
   set->Add("mvs.growing.seeds_from_neighbors", &m.growing.seeds_from_neighbors,
            "also seed from the neighbours' features projected into R");
+  set->Add("mvs.growing.revisit_margin", &m.growing.revisit_margin,
+           "revisit a pixel only from a candidate whose confidence beats the "
+           "stored one by more than this (paper: 0)",
+           0, 1);
   set->Add("mvs.sweep.step", &m.sweep.step,
            "fallback depth sweep: test every step-th pixel", 1, kIntMax);
   set->Add("mvs.sweep.num_depths", &m.sweep.num_depths,

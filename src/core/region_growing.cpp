@@ -16,6 +16,8 @@ namespace wild_mvs {
 void RegionGrowingOptions::Check() const {
   Require(tile_size >= 8 && tile_size <= 4096,
           "growing.tile_size = ", tile_size, " must be in [8, 4096]");
+  Require(revisit_margin >= 0 && revisit_margin <= 1,
+          "growing.revisit_margin = ", revisit_margin, " must be in [0, 1]");
 }
 
 double ThreadCpuSeconds() {
@@ -180,6 +182,14 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
   }
 
   const Camera& cam = context.ref_camera;
+  // Whether a candidate of confidence conf may (re)visit pixel p: always
+  // when p holds nothing, else only when it beats p's confidence by more
+  // than the margin.
+  const float margin = static_cast<float>(options.revisit_margin);
+  auto worth_visit = [&](int p, float conf) {
+    const float have = cmap[p];
+    return !(have > 0) || (have < conf && conf - have > margin);
+  };
   auto process_tile = [&](int tile) {
     auto m = matchers.Acquire();
     const int tx0 = (tile % ntx) * T, ty0 = (tile / ntx) * T;
@@ -192,7 +202,7 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
       const Candidate c = q.back();
       q.pop_back();
       const int p = c.pixel;
-      if (cmap[p] >= c.conf) continue;
+      if (!worth_visit(p, c.conf)) continue;
       const int x = p % W, y = p / W;
       ++visits[tile];
       if (!m->Match(x, y, c.depth,
@@ -211,7 +221,7 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
         const int nx = x + dx[k], ny = y + dy[k];
         if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
         const int np = ny * W + nx;
-        if (cmap[np] >= conf) continue;
+        if (!worth_visit(np, conf)) continue;
         if (mmap && !mmap[np]) continue;
         if (!m->WindowInside(nx, ny)) continue;
         Candidate nc;

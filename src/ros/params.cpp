@@ -74,6 +74,7 @@ void BindMvs(Binder& b, MvsOptions* m) {
   b.Bind("mvs/optimize_color_scale", &m->mpgc.optimize_color_scale);
   b.Bind("mvs/tile_size", &m->growing.tile_size);
   b.Bind("mvs/seeds_from_neighbors", &m->growing.seeds_from_neighbors);
+  b.Bind("mvs/revisit_margin", &m->growing.revisit_margin);
   b.Bind("mvs/sweep_step", &m->sweep.step);
   b.Bind("mvs/sweep_num_depths", &m->sweep.num_depths);
   b.Bind("mvs/use_color", &m->use_color);
