@@ -91,13 +91,21 @@ bool PatchMatcher::PrepareView(int v, int slot_index) {
 }
 
 // Samples view slot at the current (h, hs, ht); false when any window pixel
-// falls outside the image or behind the camera.
-bool PatchMatcher::SampleSlot(int slot_index, bool with_gradient) {
+// falls outside the image or behind the camera. C = channels, G = with the
+// derivative along the ray.
+template <int C, bool G>
+bool PatchMatcher::SampleSlotT(int slot_index) {
   SlotData& sl = slots_[slot_index];
   const PatchView& pv = ctx_.views[sl.view];
   const MatchImage& im = pv.image;
+  const float* data = im.data;
+  const int w = im.width;
+  const double xmax = im.width - 0.5, ymax = im.height - 0.5;
+  const int x0max = im.width - 2, y0max = im.height - 2;
   const double b0 = pv.b.x(), b1 = pv.b.y(), b2 = pv.b.z();
-  float val[3], gx[3], gy[3];
+  const int npix = npix_;
+  float* val = sl.val;
+  float* dval = sl.dval;
   int idx = 0;
   for (int j = -half_; j <= half_; ++j) {
     const double hrow = h_ + j * ht_;
@@ -109,26 +117,67 @@ bool PatchMatcher::SampleSlot(int slot_index, bool with_gradient) {
       const double inv = 1.0 / q2;
       const double x = (b0 + hh * a[0]) * inv;
       const double y = (b1 + hh * a[1]) * inv;
-      if (!InSampleRange(im, x, y)) return false;
-      if (with_gradient) {
-        SampleBilinear(im, x, y, val, gx, gy, 1);
-        const float dx = static_cast<float>((a[0] - x * a[2]) * inv);
-        const float dy = static_cast<float>((a[1] - y * a[2]) * inv);
-        for (int c = 0; c < channels_; ++c) {
-          sl.val[c * npix_ + idx] = val[c];
-          sl.dval[c * npix_ + idx] = gx[c] * dx + gy[c] * dy;
+      if (!(x >= 0.5 && y >= 0.5 && x < xmax && y < ymax)) return false;
+      const double fxd = x - 0.5, fyd = y - 0.5;
+      int x0 = static_cast<int>(fxd), y0 = static_cast<int>(fyd);
+      if (x0 > x0max) x0 = x0max;
+      if (y0 > y0max) y0 = y0max;
+      const float fx = static_cast<float>(fxd - x0),
+                  fy = static_cast<float>(fyd - y0);
+      const float* p00 = data + (static_cast<size_t>(y0) * w + x0) * C;
+      const float* p01 = p00 + static_cast<size_t>(w) * C;
+      float dx = 0, dy = 0;
+      if (G) {
+        dx = static_cast<float>((a[0] - x * a[2]) * inv);
+        dy = static_cast<float>((a[1] - y * a[2]) * inv);
+      }
+      for (int c = 0; c < C; ++c) {
+        const float v00 = p00[c], v10 = p00[C + c], v01 = p01[c],
+                    v11 = p01[C + c];
+        const float dtop = v10 - v00, dbot = v11 - v01;
+        const float top = v00 + fx * dtop, bot = v01 + fx * dbot;
+        val[c * npix + idx] = top + fy * (bot - top);
+        if (G) {
+          const float gx = dtop + fy * (dbot - dtop);
+          const float gy = bot - top;
+          dval[c * npix + idx] = gx * dx + gy * dy;
         }
-      } else {
-        SampleBilinear(im, x, y, val, nullptr, nullptr, 1);
-        for (int c = 0; c < channels_; ++c) sl.val[c * npix_ + idx] = val[c];
       }
     }
   }
   return true;
 }
 
+bool PatchMatcher::SampleSlot(int slot_index, bool with_gradient) {
+  if (channels_ == 3)
+    return with_gradient ? SampleSlotT<3, true>(slot_index)
+                         : SampleSlotT<3, false>(slot_index);
+  return with_gradient ? SampleSlotT<1, true>(slot_index)
+                       : SampleSlotT<1, false>(slot_index);
+}
+
+// NccChannels(ref_, val) with R's centred window and its sum of squares
+// precomputed in SetupPixel: sab = sum (r - mean_r) * v needs no mean of v.
 double PatchMatcher::SlotNcc(int slot_index) const {
-  return NccChannels(ref_, slots_[slot_index].val, npix_, channels_, npix_);
+  const float* v = slots_[slot_index].val;
+  const int n = npix_;
+  double sbb = 0, sab = 0;
+  for (int c = 0; c < channels_; ++c) {
+    const float* pv = v + c * n;
+    const float* pr = ref_centered_ + c * n;
+    double sb = 0, sbb_c = 0, sab_c = 0;
+    for (int i = 0; i < n; ++i) {
+      const double b = pv[i];
+      sb += b;
+      sbb_c += b * b;
+      sab_c += pr[i] * b;
+    }
+    sbb += sbb_c - sb * sb / n;
+    sab += sab_c;
+  }
+  const double m = static_cast<double>(n) * channels_;
+  if (ref_saa_ < kNccMinVariance * m || sbb < kNccMinVariance * m) return -1;
+  return sab / std::sqrt(ref_saa_ * sbb);
 }
 
 void PatchMatcher::InitScales(int slot_index) {
@@ -206,6 +255,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   int idx = 0;
   for (int c = 0; c < 3; ++c) ref_sum_[c] = 0;
   double var_total = 0;
+  ref_saa_ = 0;
   for (int j = -half_; j <= half_; ++j) {
     const float* row =
         ri.data +
@@ -224,7 +274,10 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
     const double mean = ref_sum_[c] / npix_;
     for (int i = 0; i < npix_; ++i) {
       const double d = ref_[c * npix_ + i] - mean;
+      const float df = static_cast<float>(d);
+      ref_centered_[c * npix_ + i] = df;
       var_total += d * d;
+      ref_saa_ += static_cast<double>(df) * df;
     }
   }
   // A textureless reference window cannot be matched (NCC undefined).
@@ -339,6 +392,35 @@ bool PatchMatcher::Match(int s, int t, double depth,
     const bool full = changed || (it % mpgc_.full_update_interval == 0);
     const bool geo3 = full && fit_normal;
     const bool scales = full && fit_scale;
+    if (!geo3 && !scales) {
+      // Depth only, scales fixed: H = sum q^2, g = sum q e (1 x 1).
+      double q2 = 0, qe = 0;
+      for (int a = 0; a < num_active_; ++a) {
+        const SlotData& sl = slots_[active_slot_[a]];
+        for (int c = 0; c < channels_; ++c) {
+          const float* val = sl.val + c * npix_;
+          const float* dv = sl.dval + c * npix_;
+          const float* rv = ref_ + c * npix_;
+          const float sc = sl.scale[c];
+          float r_q2 = 0, r_qe = 0;
+          for (int idx = 0; idx < npix_; ++idx) {
+            const float q = sc * dv[idx];
+            const float e = rv[idx] - sc * val[idx];
+            r_q2 += q * q;
+            r_qe += q * e;
+          }
+          q2 += r_q2;
+          qe += r_qe;
+        }
+      }
+      if (!(q2 > 1e-20)) return false;
+      const double dh = qe / q2;
+      if (!std::isfinite(dh)) return false;
+      h_ += dh;
+      if (!(h_ > 0) || !std::isfinite(h_)) return false;
+      changed = false;
+      continue;
+    }
     Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     double sii[kMaxActive][3], sie[kMaxActive][3];

@@ -71,6 +71,8 @@ class PatchMatcher {
   bool SetupPixel(int s, int t, double depth, const Eigen::Vector3d& normal);
   bool PrepareView(int v, int slot_index);
   bool SampleSlot(int slot_index, bool with_gradient);
+  template <int C, bool G>
+  bool SampleSlotT(int slot_index);
   double SlotNcc(int slot_index) const;
   void InitScales(int slot_index);
   int FreeSlot() const;
@@ -88,6 +90,8 @@ class PatchMatcher {
   double inv_norm_[kMaxWindowPixels];  // 1 / |K^-1 (u, v, 1)|
   float ref_[3 * kMaxWindowPixels];    // planar: channel c at c * npix
   double ref_sum_[3];
+  float ref_centered_[3 * kMaxWindowPixels];  // ref_ minus its channel mean
+  double ref_saa_ = 0;                        // sum of squares of the above
   // Candidate state this visit: 0 free, 1 active, 2 rejected.
   uint8_t state_[kMaxNeighbors];
   Eigen::Vector2d epi_dir_[kMaxNeighbors];
