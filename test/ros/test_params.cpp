@@ -17,6 +17,7 @@ TEST(Params, DefaultsAreValid) {
   EXPECT_EQ(d.stream.mvs.global.num_neighbors, 10);  // paper default kept
   const FusionNodeOptions f = ReadFusionNodeOptions(none);
   EXPECT_EQ(f.fusion.min_support, FusionOptions().min_support);
+  EXPECT_EQ(f.on_new_session, "keep");
 }
 
 TEST(Params, ValuesReachTheCoreOptions) {
@@ -82,6 +83,18 @@ TEST(Params, BadValuesNameTheParameter) {
             std::string::npos);
   MapParamSource f({{"fusion/min_support", 0}});
   EXPECT_THROW(ReadFusionNodeOptions(f), Error);
+  // Reset policy of the fusion node: keep or reset, nothing else.
+  EXPECT_EQ(ReadFusionNodeOptions(
+                MapParamSource({{"on_new_session", std::string("reset")}}))
+                .on_new_session,
+            "reset");
+  try {
+    ReadFusionNodeOptions(
+        MapParamSource({{"on_new_session", std::string("clear")}}));
+    ADD_FAILURE() << "on_new_session 'clear' accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("on_new_session"), std::string::npos);
+  }
 }
 
 TEST(Params, UnknownParametersAreListed) {
