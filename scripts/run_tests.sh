@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs every test: installs what is missing (Debian 12 packages), builds,
-# runs the unit, CLI and ROS tests with ctest, then a short fuzz run of every
-# reader (scripts/run_fuzz.sh: clang ASan/UBSan build in build-fuzz/,
-# FUZZ_SECONDS per harness, default 20). WILD_MVS_SANITIZERS=1 also runs
+# runs the unit, CLI and ROS tests with ctest, then the deterministic fuzz
+# step of every reader (scripts/run_fuzz.sh: clang ASan/UBSan build in
+# build-fuzz/; replays the committed corpus and regressions, then a fixed
+# number of executions per harness with a fixed seed). WILD_MVS_SANITIZERS=1 also runs
 # scripts/run_sanitizers.sh (ASan/UBSan build running every test again, and
 # TSan on the parallel code); WILD_MVS_NO_FUZZ=1 skips the fuzz run.
 # Usage: scripts/run_tests.sh
@@ -18,6 +19,6 @@ if [ -n "${WILD_MVS_SANITIZERS:-}" ]; then
   bash "$WILD_MVS_ROOT/scripts/run_sanitizers.sh" || hard=1
 fi
 if [ -z "${WILD_MVS_NO_FUZZ:-}" ]; then
-  bash "$WILD_MVS_ROOT/scripts/run_fuzz.sh" "${FUZZ_SECONDS:-20}" || hard=1
+  bash "$WILD_MVS_ROOT/scripts/run_fuzz.sh" || hard=1
 fi
 [ "$hard" = 0 ] || { echo "run_tests.sh: hardening checks failed" >&2; exit 1; }

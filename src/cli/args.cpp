@@ -7,8 +7,7 @@ namespace wild_mvs {
 namespace cli {
 
 Args::Args(const CommandSpec& spec, const std::vector<std::string>& argv,
-           const OptionSet* core)
-    : spec_(spec) {
+           const OptionSet* core) {
   bool flags_done = false;
   for (size_t i = 0; i < argv.size(); ++i) {
     const std::string& a = argv[i];

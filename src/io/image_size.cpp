@@ -3,6 +3,7 @@
 
 #include <cctype>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -106,8 +107,10 @@ ImageSize ReadImageSize(const std::string& path) {
     int32_t w, hh;
     std::memcpy(&w, h + 18, 4);
     std::memcpy(&hh, h + 22, 4);
+    // A negative height means a top-down bitmap; INT32_MIN has no positive
+    // counterpart (not a real size: OpenCV decides below).
     s.width = w;
-    s.height = hh < 0 ? -hh : hh;
+    s.height = hh == INT32_MIN ? 0 : (hh < 0 ? -hh : hh);
     ok = true;
   }
   if (!ok || s.width <= 0 || s.height <= 0) {

@@ -24,13 +24,16 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 bool Finite(double v) { return std::isfinite(v); }
 
+// Largest image side accepted from a message (images and camera_info).
+constexpr uint32_t kMaxMsgImageSide = 32768;
+
 // Wraps msg.data as a cv::Mat of `type` after checking the layout.
 cv::Mat WrapImage(const sensor_msgs::Image& msg, int type,
                   const std::string& what) {
   Require(msg.width > 0 && msg.height > 0, what, ": empty image (", msg.width,
           "x", msg.height, ")");
-  Require(msg.width <= 32768 && msg.height <= 32768, what, ": image of ",
-          msg.width, "x", msg.height, " is too large");
+  Require(msg.width <= kMaxMsgImageSide && msg.height <= kMaxMsgImageSide, what,
+          ": image of ", msg.width, "x", msg.height, " is too large");
   const size_t row_bytes = static_cast<size_t>(msg.width) * CV_ELEM_SIZE(type);
   Require(msg.step >= row_bytes, what, ": step ", msg.step,
           " is shorter than a row of ", msg.width, " pixels of encoding '",
@@ -70,6 +73,10 @@ void CameraFromCameraInfo(const sensor_msgs::CameraInfo& info, Camera* camera,
   const auto& K = info.K;
   Require(info.width > 0 && info.height > 0, "camera_info: image size is ",
           info.width, "x", info.height);
+  // Larger sizes would also overflow Camera's int width/height.
+  Require(info.width <= kMaxMsgImageSide && info.height <= kMaxMsgImageSide,
+          "camera_info: image size ", info.width, "x", info.height,
+          " is too large (at most ", kMaxMsgImageSide, " per side)");
   for (double v : K)
     Require(Finite(v), "camera_info: K has a non-finite value");
   Require(K[0] > 0 && K[4] > 0,

@@ -64,6 +64,24 @@ TEST(Conversions, CameraInfoRejectsBadIntrinsics) {
   EXPECT_THROW(CameraFromCameraInfo(MakeInfo(640, 480, NAN, 319.5, 239.5), &cam,
                                     nullptr),
                Error);
+  // fuzz_ros_messages regression (corpus crash_camera_info_height_over_
+  // int_max): a height of 2885681632 passed the `> 0` check as uint32 and
+  // became a negative Camera::height. Sizes above 32768 are refused.
+  auto huge = MakeInfo(640, 480, 500, 319.5, 239.5);
+  huge.height = 2885681632u;
+  try {
+    CameraFromCameraInfo(huge, &cam, nullptr);
+    ADD_FAILURE() << "huge camera_info accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("640x2885681632 is too large"),
+              std::string::npos)
+        << e.what();
+  }
+  huge.height = 32769;
+  EXPECT_THROW(CameraFromCameraInfo(huge, &cam, nullptr), Error);
+  huge.height = 32768;  // the largest accepted
+  CameraFromCameraInfo(huge, &cam, nullptr);
+  EXPECT_EQ(cam.height, 32768);
   auto fisheye = MakeInfo(640, 480, 500, 319.5, 239.5);
   fisheye.distortion_model = "equidistant";
   fisheye.D = {0.1, 0.01, 0, 0};

@@ -5,6 +5,7 @@
 // memory errors themselves; in the normal build they check the results.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -13,6 +14,7 @@
 #include "wild_mvs/cli/option_set.h"
 #include "wild_mvs/cli/reconstruct_config.h"
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/io/image_size.h"
 
 namespace wild_mvs {
 namespace {
@@ -54,6 +56,34 @@ TEST(FuzzRegressions, YamlConfigKeysOutliveTheIterator) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml line 3"), std::string::npos)
         << e.what();
   }
+}
+
+// fuzz_image_size, CI run: a BMP header with height INT32_MIN (a top-down
+// bitmap of 2^31 rows) made ReadImageSize negate INT32_MIN (UBSan: "negation
+// of -2147483648 cannot be represented in type 'int32_t'"). Fixed: such a
+// height is no size, OpenCV decides, and refuses it. A normal top-down BMP
+// (negative height) still gives its positive height.
+TEST(FuzzRegressions, BmpHeightInt32MinIsRefused) {
+  const std::string dir = testing::MakeTempDir("fuzz_bmp");
+  const std::string path = dir + "/image.bmp";
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << ReadCorpus("image_size", "crash_bmp_height_int32_min");
+  }
+  try {
+    const ImageSize s = ReadImageSize(path);
+    ADD_FAILURE() << "accepted as " << s.width << "x" << s.height;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << ReadCorpus("image_size", "bmp_top_down");
+  }
+  const ImageSize s = ReadImageSize(path);
+  EXPECT_EQ(s.width, 2);
+  EXPECT_EQ(s.height, 2);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

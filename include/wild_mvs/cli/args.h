@@ -75,7 +75,6 @@ class Args {
   void ApplyCoreAssignments(OptionSet* set) const;
 
  private:
-  const CommandSpec& spec_;
   bool help_ = false;
   std::vector<std::string> positionals_;
   std::map<std::string, std::string> values_;
