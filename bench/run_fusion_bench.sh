@@ -4,13 +4,17 @@
 # is its own) and prints one table row per run.
 #
 #   bench/run_fusion_bench.sh [--bin BENCH_FUSION] [--threads T]
-#                             [--repeat R] OUT[:N] [OUT[:N] ...]
+#                             [--repeat R] [--cache-mb M] [--pending-mb P]
+#                             OUT[:N] [OUT[:N] ...]
 #
 # OUT:N fuses only the first N views (name order) of OUT. With --repeat R
 # each run is repeated R times and the row with the median CPU time is kept
 # (the machine may be shared). Columns: views, wall and CPU seconds, output
 # points, the fusion's own peak accounting (total; depth maps held at once),
-# the process's peak RSS and its RSS before fusion started.
+# the process's peak RSS and its RSS before fusion started. --cache-mb and
+# --pending-mb set the fusion's depth-map cache and pending-sample budgets
+# (defaults 512 and 256 MB: below them everything is kept, so to see the
+# bound, give budgets smaller than all maps together).
 #
 # Example (templeSparseRing = 16 views, templeRing = 47 views, 640 x 480):
 #   bench/run_fusion_bench.sh /tmp/templeSR /tmp/templeRing:16 /tmp/templeRing
@@ -20,13 +24,15 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${BENCH_FUSION:-$ROOT/build/bin/bench_fusion}"
 THREADS=1
 REPEAT=1
+EXTRA=()
 RUNS=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --bin) BIN="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
     --repeat) REPEAT="$2"; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --cache-mb|--pending-mb) EXTRA+=("$1" "$2"); shift 2 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     -*) echo "run_fusion_bench.sh: unknown option $1" >&2; exit 2 ;;
     *) RUNS+=("$1"); shift ;;
   esac
@@ -43,7 +49,7 @@ for run in "${RUNS[@]}"; do
   [[ -d "$dir/cameras" ]] || { echo "run_fusion_bench.sh: $dir/cameras: not a reconstruct folder" >&2; exit 1; }
   rows=()
   for ((r = 0; r < REPEAT; ++r)); do
-    args=("$dir" --threads "$THREADS")
+    args=("$dir" --threads "$THREADS" "${EXTRA[@]}")
     [[ "$n" -gt 0 ]] && args+=(--views "$n")
     out="$("$BIN" "${args[@]}")" || { echo "run_fusion_bench.sh: bench_fusion failed on $run" >&2; exit 1; }
     # "views V  time W s (...)  cpu C s  points P ..." /
