@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
     std::cerr << "usage: bench_mvs MODEL_DIR IMAGES_DIR [--threads N] "
                  "[--views i,j] [--max-image-size S] [--previews DIR] "
                  "[--grey] [--no-lvs] [--no-normal] [--no-color-scale] "
-                 "[--min-views K] [--save DIR]\n";
+                 "[--min-views K] [--revisit-margin M] [--save DIR]\n";
     return 2;
   }
   try {
@@ -74,6 +74,8 @@ int main(int argc, char** argv) {
         opt.mpgc.optimize_normal = false;
       } else if (a == "--no-color-scale") {
         opt.mpgc.optimize_color_scale = false;
+      } else if (a == "--revisit-margin") {
+        opt.growing.revisit_margin = std::stod(next());
       } else if (a == "--min-views") {
         opt.mpgc.min_active_views = std::stoi(next());
       } else {
