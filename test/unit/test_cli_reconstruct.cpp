@@ -315,6 +315,43 @@ TEST_F(CliReconstruct, BadOutputFolderViewsAndMasksGiveClearErrors) {
       << r.output;
 }
 
+TEST_F(CliReconstruct, UnreadableOutputFolderAndEarlierResults) {
+  // OUT is a regular file: refused, named, and the file is untouched.
+  const std::string file = root_ + "/out_is_a_file";
+  std::ofstream(file) << "keep me";
+  RunResult r = RunCli("reconstruct '" + dataset_ + "' '" + file + "'");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("wild_mvs reconstruct: " + file), std::string::npos)
+      << r.output;
+  EXPECT_EQ(ReadFile(file), "keep me");
+
+  // An earlier depth map that cannot be read (truncated PFM) when a later
+  // stage needs it: the error names the file, the run exits 1, no fused
+  // cloud or temporary file is written and the other results are untouched.
+  ASSERT_EQ(first_.status, 0) << first_.output;
+  const std::string out = root_ + "/out_unreadable";
+  fs::copy(out_, out, fs::copy_options::recursive);
+  fs::remove(out + "/fused.ply");
+  fs::remove(out + "/mesh.ply");
+  const std::string stem0 = scene_->scene.views[0].Stem();
+  const std::string stem1 = scene_->scene.views[1].Stem();
+  const DepthMapPaths bad = MakeDepthMapPaths(out, stem0);
+  const std::string good = MakeDepthMapPaths(out, stem1).depth;
+  const std::string good_before = ReadFile(good);
+  {
+    const std::string head = ReadFile(bad.depth).substr(0, 20);
+    std::ofstream(bad.depth, std::ios::binary | std::ios::trunc) << head;
+  }
+  r = RunCli("reconstruct '" + dataset_ + "' '" + out +
+             "' --stages fuse --threads 2");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find(bad.depth), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("truncated"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out + "/fused.ply"));
+  EXPECT_EQ(CountTempFiles(out), 0);
+  EXPECT_EQ(ReadFile(good), good_before);
+}
+
 TEST_F(CliReconstruct, MaskExcludesPixels) {
   // The left half of view 0 masked out: no depth there, depth elsewhere.
   const View& v0 = scene_->scene.views[0];
