@@ -37,6 +37,7 @@ DIAG_COLUMNS = [
     ("depth_maps", "depth_node", "depth maps"),
     ("evicted_waiting", "depth_node", "keyframes evicted before reconstruction"),
     ("resets", "depth_node", "stream resets"),
+    ("tracker_mb", "depth_node", "tracker MB"),
     ("views_fused", "fusion_node", "views fused"),
     ("views_dropped", "fusion_node", "views dropped"),
     ("revisions_ignored", "fusion_node", "revisions ignored"),

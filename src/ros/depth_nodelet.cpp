@@ -396,6 +396,7 @@ struct DepthNode::Impl {
     stat.add("stream resets", s.resets);
     stat.addf("session", "%.6f", s.session);  // stamp that started it
     stat.add("sparse points", s.sparse_points);
+    stat.add("tracker MB", s.tracker_mb);
     stat.add("last seconds per depth map", s.last_seconds);
     stat.add("mean seconds per depth map", s.mean_seconds);
     stat.add("frames dropped", dropped);

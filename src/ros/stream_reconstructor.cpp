@@ -169,8 +169,10 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
         on_error_(Msg("tracker: keyframe ", kf->id, ": ", e.what()));
     }
     std::vector<SparsePoint> pts = tracker_->Points();
+    const double tracker_mb = tracker_->bytes() / (1024.0 * 1024.0);
     std::lock_guard<std::mutex> lock(mutex_);
     points_ = std::move(pts);
+    stats_.tracker_mb = tracker_mb;
   }
   std::lock_guard<std::mutex> lock(mutex_);
   ScheduleLocked();

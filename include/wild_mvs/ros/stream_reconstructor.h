@@ -111,6 +111,9 @@ struct StreamStats {
   uint64_t resets = 0;
   double session = -1;  // stamp that started the current session (-1: none)
   size_t sparse_points = 0;
+  // Memory of the online tracker (SparseTracker::bytes()): it keeps a few
+  // bytes per feature of every keyframe ever added, also after eviction.
+  double tracker_mb = 0;
   double last_seconds = 0, mean_seconds = 0;  // per depth map
 };
 
