@@ -3,6 +3,7 @@
 // gives the same fused cloud as one worker, within tolerance.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <sensor_msgs/Image.h>
 #include <wild_mvs/DepthView.h>
 
 #include <algorithm>
@@ -70,6 +71,24 @@ TEST(TwoWorkers, SameCloudAsOneWorker) {
                c1.getNumPublishers() > 0 && c2.getNumPublishers() > 0;
       },
       60));
+  // Every depth node (one + two workers) is up and subscribed to the images
+  // before the bag starts (a late nodelet missed the first frames under
+  // load): each publishes diagnostics once constructed (after subscribing),
+  // and both processes (depth_node, the manager) connect to a silent
+  // publisher of the image topic.
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        return diag.Get("one/depth_node", "input queue size") > 0 &&
+               diag.Get("two/depth_worker_0", "input queue size") > 0 &&
+               diag.Get("two/depth_worker_1", "input queue size") > 0;
+      },
+      60));
+  {
+    ros::Publisher probe =
+        nh.advertise<sensor_msgs::Image>("/camera/image_raw", 1);
+    ASSERT_TRUE(WaitFor([&] { return probe.getNumSubscribers() >= 2; }, 60))
+        << probe.getNumSubscribers() << " image subscribers";
+  }
   ros::WallDuration(1.0).sleep();
   std::thread player = PlayBag(bag, 1.0);
   player.join();
