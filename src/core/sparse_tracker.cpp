@@ -68,7 +68,7 @@ struct ViewData {
   int id = -1;
   Camera camera;
   Features features;
-  int offset = 0;  // first union-find node of this view
+  int offset = 0;  // first union-find node of this view (when count > 0)
   int count = 0;   // number of features (nodes)
   bool removed = false;
   std::vector<int> neighbors;  // ids matched against when added
@@ -189,11 +189,19 @@ struct SparseTracker::Impl {
   std::vector<ViewData> views;              // in the order added
   std::map<int, int> slot_of_id;            // view id -> index into views
   std::vector<int> parent;                  // union-find over features
-  std::vector<int> node_slot;               // view slot of each node
+  std::vector<int> node_slot;               // view slot of each node, -1 for
+                                            // a kept root of a removed view
   std::map<int, std::vector<int>> members;  // root -> nodes (size >= 2)
-  std::map<int, PointData> points;          // root -> triangulated track
+  // root -> nodes of removed views dropped from members by Compact(): they
+  // still count in the component's size (union by size), so that compaction
+  // changes no later union and no result.
+  std::map<int, int> dropped;
+  std::map<int, PointData> points;  // root -> triangulated track
   int pairs_matched = 0;
   long long matches = 0;
+  // Since the last Compact(): nodes and records of removed views.
+  long long removed_nodes = 0;
+  int removed_views = 0;
 
   int Find(int x) {
     while (parent[x] != x) {
@@ -209,7 +217,9 @@ struct SparseTracker::Impl {
     if (ra == rb) return ra;
     auto size_of = [this](int r) {
       auto it = members.find(r);
-      return it == members.end() ? size_t{1} : it->second.size();
+      auto dt = dropped.find(r);
+      return (it == members.end() ? size_t{1} : it->second.size()) +
+             (dt == dropped.end() ? size_t{0} : size_t(dt->second));
     };
     // Larger component stays root; ties to the smaller index.
     const size_t sa = size_of(ra), sb = size_of(rb);
@@ -222,6 +232,11 @@ struct SparseTracker::Impl {
     } else {
       into.insert(into.end(), it->second.begin(), it->second.end());
       members.erase(it);
+    }
+    auto dt = dropped.find(rb);
+    if (dt != dropped.end()) {
+      dropped[ra] += dt->second;
+      dropped.erase(dt);
     }
     points.erase(rb);
     parent[rb] = ra;
@@ -343,8 +358,8 @@ struct SparseTracker::Impl {
     std::sort(sorted.begin(), sorted.end());  // deterministic twin choice
     for (int n : sorted) {
       const int s = node_slot[n];
+      if (s < 0 || views[s].removed) continue;
       const ViewData& v = views[s];
-      if (v.removed) continue;
       std::vector<int>& list = by_slot[s];
       bool twin = false;
       for (int m : list) {
@@ -473,6 +488,77 @@ struct SparseTracker::Impl {
     points[root] = std::move(pd);
   }
 
+  // Forgets the nodes and records of removed views. A node is kept when its
+  // view is held or when it is the root of a component with a held node
+  // (the root's index orders Points() and breaks union ties); kept nodes are
+  // renumbered in their old order and every decision of the tracker depends
+  // only on that order and on component sizes (kept in `dropped`), so the
+  // results are those without compaction. Components without a held node
+  // (their points are invalid) are dropped.
+  void Compact() {
+    const int n = static_cast<int>(parent.size());
+    std::vector<int> root(n);
+    for (int i = 0; i < n; ++i) root[i] = Find(i);
+    auto held = [this](int i) {
+      return node_slot[i] >= 0 && !views[node_slot[i]].removed;
+    };
+    std::vector<char> keep(n, 0);
+    for (int i = 0; i < n; ++i) {
+      if (held(i)) keep[i] = keep[root[i]] = 1;
+    }
+    std::vector<int> new_index(n, -1);
+    int kept = 0;
+    for (int i = 0; i < n; ++i) {
+      if (keep[i]) new_index[i] = kept++;
+    }
+    std::vector<int> new_slot(views.size(), -1);
+    std::vector<ViewData> new_views;
+    new_views.reserve(views.size() - removed_views);
+    for (size_t s = 0; s < views.size(); ++s) {
+      if (views[s].removed) continue;
+      new_slot[s] = static_cast<int>(new_views.size());
+      new_views.push_back(std::move(views[s]));
+      ViewData& v = new_views.back();
+      v.offset = v.count > 0 ? new_index[v.offset] : 0;
+    }
+    std::vector<int> new_parent(kept), new_node_slot(kept);
+    for (int i = 0; i < n; ++i) {
+      if (!keep[i]) continue;
+      new_parent[new_index[i]] = new_index[root[i]];
+      new_node_slot[new_index[i]] = held(i) ? new_slot[node_slot[i]] : -1;
+    }
+    std::map<int, std::vector<int>> new_members;
+    std::map<int, int> new_dropped;
+    for (auto& kv : members) {
+      if (!keep[kv.first]) continue;
+      std::vector<int> list;
+      for (int m : kv.second) {
+        if (keep[m]) list.push_back(new_index[m]);
+      }
+      const int r = new_index[kv.first];
+      auto dt = dropped.find(kv.first);
+      const int d = static_cast<int>(kv.second.size() - list.size()) +
+                    (dt == dropped.end() ? 0 : dt->second);
+      if (d > 0) new_dropped[r] = d;
+      new_members[r] = std::move(list);
+    }
+    std::map<int, PointData> new_points;
+    for (auto& kv : points) {
+      if (keep[kv.first]) {
+        new_points[new_index[kv.first]] = std::move(kv.second);
+      }
+    }
+    for (auto& kv : slot_of_id) kv.second = new_slot[kv.second];
+    views = std::move(new_views);
+    parent = std::move(new_parent);
+    node_slot = std::move(new_node_slot);
+    members = std::move(new_members);
+    dropped = std::move(new_dropped);
+    points = std::move(new_points);
+    removed_nodes = 0;
+    removed_views = 0;
+  }
+
   static Eigen::Vector3f MeanColour(const Eigen::Vector3f& sum, size_t n) {
     return n ? Eigen::Vector3f(sum / (255.0f * n))
              : Eigen::Vector3f(0.5f, 0.5f, 0.5f);
@@ -594,7 +680,17 @@ void SparseTracker::RemoveView(int view_index) {
   }
   for (int r : roots) m.Rebuild(r);
   v.features = Features();  // free descriptors; positions no longer needed
+  v.neighbors = std::vector<int>();
   m.slot_of_id.erase(it);
+  m.removed_nodes += v.count;
+  ++m.removed_views;
+  // Amortised: compaction costs O(nodes + views) and runs once removed
+  // nodes (or records) make up more than half of them.
+  if (m.opt.compact &&
+      (2 * m.removed_nodes > static_cast<long long>(m.parent.size()) ||
+       2 * m.removed_views > static_cast<int>(m.views.size()))) {
+    m.Compact();
+  }
 }
 
 bool SparseTracker::HasView(int view_index) const {
@@ -647,11 +743,21 @@ TrackerStats SparseTracker::Stats() const {
 
 size_t SparseTracker::bytes() const {
   const Impl& m = *impl_;
+  // Map nodes: key, value and ~32 B of tree links and allocator overhead.
+  constexpr size_t kNode = 32;
   size_t b = (m.parent.capacity() + m.node_slot.capacity()) * sizeof(int);
-  for (const ViewData& v : m.views) b += sizeof(ViewData) + v.features.bytes();
-  for (const auto& kv : m.members) b += 64 + kv.second.capacity() * sizeof(int);
+  b += m.views.capacity() * sizeof(ViewData);
+  for (const ViewData& v : m.views) {
+    b += v.features.bytes() + v.neighbors.capacity() * sizeof(int);
+  }
+  b += m.slot_of_id.size() * (kNode + 2 * sizeof(int));
+  b += m.dropped.size() * (kNode + 2 * sizeof(int));
+  for (const auto& kv : m.members) {
+    b += kNode + sizeof(kv) + kv.second.capacity() * sizeof(int);
+  }
   for (const auto& kv : m.points) {
-    b += 96 + kv.second.point.track.capacity() * sizeof(Observation);
+    b += kNode + sizeof(kv) +
+         kv.second.point.track.capacity() * sizeof(Observation);
   }
   return b;
 }

@@ -350,6 +350,55 @@ TEST(SparseTracker, RemoveViewDropsItsObservations) {
   EXPECT_GE(tracker.Points().size(), pts.size());
 }
 
+// A stream with a bounded store: views are added and the oldest removed
+// (4 held) for 200 additions on a ring of 12 cameras, each camera coming
+// back under a new id every 12 additions. With compaction the memory follows
+// the views held, not the views ever added, and every result is identical
+// to the tracker without compaction.
+TEST(SparseTracker, CompactionBoundsMemoryAndKeepsResults) {
+  const int n = 12, kHeld = 4, kAdds = 200;
+  const FeatureWorld w = MakeWorld(n, 360.0 * (n - 1) / n, 400, 0.2, 11);
+  TrackerOptions opt;
+  SparseTracker compact(opt);
+  opt.compact = false;
+  SparseTracker plain(opt);
+  size_t bytes_20 = 0, plain_20 = 0, peak = 0;
+  for (int id = 0; id < kAdds; ++id) {
+    for (SparseTracker* t : {&compact, &plain}) {
+      t->AddView(id, w.cameras[id % n], w.features[id % n]);
+      if (id >= kHeld) t->RemoveView(id - kHeld);
+    }
+    if (id + 1 == 20) bytes_20 = compact.bytes(), plain_20 = plain.bytes();
+    if (id >= 20) peak = std::max(peak, compact.bytes());
+    const auto a = compact.Points(), b = plain.Points();
+    ASSERT_EQ(a.size(), b.size()) << "after view " << id;
+    for (size_t k = 0; k < a.size(); ++k) {
+      ASSERT_EQ(a[k].xyz, b[k].xyz) << "after view " << id;
+      ASSERT_EQ(a[k].track.size(), b[k].track.size());
+      for (size_t o = 0; o < a[k].track.size(); ++o) {
+        EXPECT_EQ(a[k].track[o].view, b[k].track[o].view);
+        EXPECT_EQ(a[k].track[o].xy, b[k].track[o].xy);
+      }
+      EXPECT_EQ(a[k].rgb, b[k].rgb);
+      EXPECT_EQ(a[k].error, b[k].error);
+    }
+    EXPECT_EQ(compact.MatchedNeighbors(id), plain.MatchedNeighbors(id));
+    EXPECT_EQ(compact.Stats().points, plain.Stats().points);
+    EXPECT_EQ(compact.Stats().views, std::min(id + 1, kHeld));
+  }
+  const auto pts = compact.Points();
+  EXPECT_GT(pts.size(), 100u);
+  for (const SparsePoint& p : pts) {
+    for (const Observation& o : p.track) EXPECT_GE(o.view, kAdds - kHeld);
+  }
+  std::cout << "tracker bytes after 20 / " << kAdds << " views: compacted "
+            << bytes_20 << " / " << compact.bytes() << ", not compacted "
+            << plain_20 << " / " << plain.bytes() << "; compacted peak after "
+            << "20 views " << peak << std::endl;
+  EXPECT_LT(peak, 1.5 * bytes_20);
+  EXPECT_GT(plain.bytes(), 3 * plain_20);  // the leak this test guards
+}
+
 // A view whose pose is wrong by more than the epipolar tolerance finds
 // (almost) no matches: the known geometry gates the matching.
 TEST(SparseTracker, EpipolarGateRejectsWrongPose) {

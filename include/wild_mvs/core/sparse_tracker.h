@@ -88,6 +88,13 @@ struct TrackerOptions {
   // Gauss-Newton iterations of the nonlinear refinement.
   int refine_iterations = 10;
 
+  // --- Memory ---
+  // RemoveView compacts the union-find and the view records once removed
+  // features (or views) make up more than half of them, so memory follows
+  // the views currently held. The results are identical either way; false
+  // only to test that (memory then grows with every view ever added).
+  bool compact = true;
+
   void Check() const;
 };
 
@@ -97,7 +104,8 @@ struct TrackerStats {
   int pairs_matched = 0;
   long long matches = 0;
   long long features = 0;
-  int tracks = 0;              // components that received matches
+  int tracks = 0;  // components that received matches (once compacted,
+                   // those with a feature in a view still held)
   int conflicting_tracks = 0;  // two distinct features in one view
   int points = 0;              // tracks that passed every filter
 };
@@ -105,7 +113,9 @@ struct TrackerStats {
 // Not thread-safe: call its methods from one thread at a time (the
 // streaming node serialises AddView/RemoveView/Points with a mutex).
 // Memory: descriptors (128 B per feature, capped by features.max_features)
-// of the views currently held, plus 8 B per feature ever added (union-find).
+// and union-find nodes (8 B per feature) of the views currently held, plus
+// the tracks; with options.compact, removed views cost at most about as much
+// again as the held ones (amortised compaction in RemoveView).
 class SparseTracker {
  public:
   // `pool` (optional, not owned) parallelises matching inside AddView; call
@@ -145,7 +155,8 @@ class SparseTracker {
   void FillScene(Scene* scene) const;
 
   TrackerStats Stats() const;
-  // Memory held by features and tracks, in bytes (approximate).
+  // Memory held by features, union-find, view records and tracks, in bytes
+  // (approximate).
   size_t bytes() const;
 
  private:
