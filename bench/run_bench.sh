@@ -34,12 +34,15 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -d "$DATASETS" ] || { echo "run_bench.sh: no datasets at $DATASETS" >&2; exit 1; }
+# Its own ROS-free build folder, so the main build/ keeps its configuration.
+export BUILD_DIR="${BUILD_DIR:-$ROOT/build-bench}"
 if [ "$BUILD" = 1 ]; then
+  mkdir -p "$BUILD_DIR"
   # shellcheck source=../scripts/common.sh
   source "$ROOT/scripts/common.sh"
   JOBS="${JOBS:-2}" wild_mvs_build -DWILD_MVS_WITH_ROS=OFF >/dev/null
 fi
-BIN="${BUILD_DIR:-$ROOT/build}/bin"
+BIN="$BUILD_DIR/bin"
 [ -n "$OUT" ] || OUT="$(mktemp -d /tmp/wild_mvs_bench.XXXXXX)"
 mkdir -p "$OUT"
 
