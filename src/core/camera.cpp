@@ -61,18 +61,17 @@ void Camera::Validate(const std::string& what) const {
           " fy=", fy, ")");
   Require(width > 0 && height > 0, what, ": image size must be positive (",
           width, "x", height, ")");
-  Require(R.allFinite() && t.allFinite(), what,
-          ": pose contains NaN or Inf");
+  Require(R.allFinite() && t.allFinite(), what, ": pose contains NaN or Inf");
   const double orth = (R * R.transpose() - Eigen::Matrix3d::Identity()).norm();
-  Require(orth < 1e-3, what, ": rotation is not orthonormal (|R R^T - I| = ",
-          orth, ")");
+  Require(orth < 1e-3, what,
+          ": rotation is not orthonormal (|R R^T - I| = ", orth, ")");
   Require(R.determinant() > 0, what,
           ": rotation is a reflection (det R = ", R.determinant(), ")");
 }
 
 Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& R) {
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(R,
-                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      R, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d out = svd.matrixU() * svd.matrixV().transpose();
   if (out.determinant() < 0) {
     Eigen::Matrix3d u = svd.matrixU();

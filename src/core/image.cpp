@@ -41,8 +41,8 @@ cv::Mat ToLinearRgb(const cv::Mat& in, bool linearize) {
       cv::cvtColor(in, rgb, cv::COLOR_BGRA2RGB);
       break;
     default:
-      throw Error(Msg("ToLinearRgb: unsupported channel count ",
-                      in.channels()));
+      throw Error(
+          Msg("ToLinearRgb: unsupported channel count ", in.channels()));
   }
   cv::Mat out;
   switch (rgb.depth()) {
@@ -83,8 +83,8 @@ cv::Mat ToLinearRgb(const cv::Mat& in, bool linearize) {
 cv::Mat LoadViewImage(const View& view, const ImageOptions& options) {
   Require(!view.image_path.empty(), "image '", view.name,
           "': no image file is known for this view");
-  cv::Mat raw = cv::imread(view.image_path,
-                           cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
+  cv::Mat raw = cv::imread(
+      view.image_path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
   Require(!raw.empty(), view.image_path,
           ": cannot read image (missing, truncated or not an image)");
   const Camera& cam = view.camera;

@@ -2,7 +2,6 @@
 #include "wild_mvs/core/local_view_selection.h"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 

@@ -9,7 +9,8 @@ namespace wild_mvs {
 ThreadPool::ThreadPool(int num_threads) {
   if (num_threads <= 0)
     num_threads = std::max(1u, std::thread::hardware_concurrency());
-  for (int i = 0; i < num_threads; ++i) workers_.emplace_back([this] { Loop(); });
+  for (int i = 0; i < num_threads; ++i)
+    workers_.emplace_back([this] { Loop(); });
 }
 
 ThreadPool::~ThreadPool() {

@@ -22,9 +22,8 @@ std::string TempNameFor(const std::string& path) {
   static thread_local std::mt19937_64 rng{std::random_device{}()};
   const fs::path p(path);
   const std::string ext = p.extension().string();  // keep for cv::imwrite
-  return (p.parent_path() /
-          ("." + p.stem().string() + ".tmp" + std::to_string(rng() % 1000000) +
-           ext))
+  return (p.parent_path() / ("." + p.stem().string() + ".tmp" +
+                             std::to_string(rng() % 1000000) + ext))
       .string();
 }
 
@@ -82,8 +81,8 @@ void WriteFileAtomically(const std::string& path,
     if (!out) {
       out.close();
       std::remove(tmp.c_str());
-      throw Error(Msg(path, ": write failed: ",
-                      err ? std::strerror(err) : "stream error"));
+      throw Error(Msg(
+          path, ": write failed: ", err ? std::strerror(err) : "stream error"));
     }
     out.close();
     if (out.fail()) {

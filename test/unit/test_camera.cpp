@@ -32,8 +32,7 @@ TEST(Camera, ProjectBackprojectRoundTrip) {
   // The world ray through px passes through X.
   const Eigen::Vector3d ray = c.RayWorld(px);
   EXPECT_NEAR(ray.norm(), 1, 1e-12);
-  EXPECT_NEAR((c.Center() + ray * (X - c.Center()).norm() - X).norm(), 0,
-              1e-9);
+  EXPECT_NEAR((c.Center() + ray * (X - c.Center()).norm() - X).norm(), 0, 1e-9);
 }
 
 TEST(Camera, BehindCameraDoesNotProject) {

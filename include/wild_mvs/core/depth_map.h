@@ -14,12 +14,12 @@ namespace wild_mvs {
 // than the input image after rescaling). Pixel (col, row) has its centre at
 // (col + 0.5, row + 0.5) in `camera`'s pixel coordinates.
 struct DepthMap {
-  int view = -1;            // index of the reference view in the Scene
-  Camera camera;            // camera of the depth map's resolution
-  cv::Mat depth;            // CV_32F, z along the optical axis; 0 = unknown
-  cv::Mat normal;           // CV_32FC3, unit normal in the camera frame,
-                            // facing the camera (n . ray < 0); 0 = unknown
-  cv::Mat confidence;       // CV_32F in [0, 1]; 0 = unknown
+  int view = -1;               // index of the reference view in the Scene
+  Camera camera;               // camera of the depth map's resolution
+  cv::Mat depth;               // CV_32F, z along the optical axis; 0 = unknown
+  cv::Mat normal;              // CV_32FC3, unit normal in the camera frame,
+                               // facing the camera (n . ray < 0); 0 = unknown
+  cv::Mat confidence;          // CV_32F in [0, 1]; 0 = unknown
   std::vector<int> neighbors;  // views it was matched against (global
                                // view selection order)
 

@@ -46,9 +46,9 @@ struct View {
 };
 
 struct Observation {
-  int view = -1;           // index into Scene::views
+  int view = -1;             // index into Scene::views
   Eigen::Vector2d xy{0, 0};  // undistorted pixel coordinates (camera.h)
-  double scale = 0;        // feature scale in pixels (SIFT size); 0 = unknown
+  double scale = 0;          // feature scale in pixels (SIFT size); 0 = unknown
 };
 
 struct SparsePoint {

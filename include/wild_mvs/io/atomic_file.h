@@ -23,7 +23,8 @@ void WriteFileAtomically(const std::string& path,
 // Same for content produced by a function that writes a complete file at a
 // given path itself (e.g. cv::imwrite): produce(tmp_path) must return true
 // on success.
-void ProduceFileAtomically(const std::string& path,
-                           const std::function<bool(const std::string&)>& produce);
+void ProduceFileAtomically(
+    const std::string& path,
+    const std::function<bool(const std::string&)>& produce);
 
 }  // namespace wild_mvs
