@@ -1,57 +1,88 @@
 #!/usr/bin/env bash
 # Sanitizer builds and runs (no findings allowed):
-#  1. build-asan/: the whole project with AddressSanitizer + UBSan
-#     (-DWILD_MVS_SANITIZE=ON, ROS off); runs every unit and CLI test with
-#     ctest, among them the end-to-end `wild_mvs reconstruct` of a small
-#     synthetic scene (test_end_to_end_synthetic) when it exists.
-#  2. build-tsan/: ThreadSanitizer build of the tests of the parallel code
-#     (depth maps, region growing, fusion, thread pool), run under TSan.
-# Usage: scripts/run_sanitizers.sh [--asan-only|--tsan-only]
+#  1. ASan + UBSan (default; scripts/run_tests.sh runs it): build-asan/, the
+#     project built with gcc -fsanitize=address,undefined
+#     -fno-sanitize-recover=all (-DWILD_MVS_SANITIZE=ON), ROS off, only the
+#     targets the tests need. Runs every unit and CLI test with ctest
+#     (ASAN_TESTS / ASAN_EXCLUDE select), among them the end-to-end runs on
+#     small rendered scenes: test_mvs_end_to_end (ReconstructView, 1 and 2
+#     threads) and test_cli_reconstruct (`wild_mvs reconstruct` sparse ->
+#     depth -> fuse -> mesh, resumed, bad output folders).
+#  2. ThreadSanitizer (opt-in, --tsan or --tsan-only): build-tsan/, the
+#     parallel code: the fusion tests and the MVS end-to-end test that runs
+#     ReconstructView with 2 threads (TSAN_TESTS, TSAN_GTEST_FILTER). Runs
+#     under `setarch -R` when available (TSan fails on some kernels with
+#     "unexpected memory mapping" when ASLR is on).
+# Usage: scripts/run_sanitizers.sh [--tsan|--tsan-only]
 # Environment: JOBS (default: cores), ASAN_BUILD_DIR, TSAN_BUILD_DIR,
-#   TSAN_TESTS (ctest regex of the TSan tests).
+#   ASAN_TESTS (ctest -R regex, default all), ASAN_EXCLUDE (ctest -E regex),
+#   TSAN_TESTS (ctest -R regex), TSAN_GTEST_FILTER.
 set -eo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 source "$ROOT/scripts/common.sh"
 ASAN_BUILD_DIR="${ASAN_BUILD_DIR:-$ROOT/build-asan}"
 TSAN_BUILD_DIR="${TSAN_BUILD_DIR:-$ROOT/build-tsan}"
-TSAN_TESTS="${TSAN_TESTS:-^test_(thread_pool|fusion|region_growing|reconstruct_view|depth_sweep|parallel)}"
-do_asan=1 do_tsan=1
+ASAN_TESTS="${ASAN_TESTS:-.}"
+TSAN_TESTS="${TSAN_TESTS:-^test_(fusion|fusion_synthetic|mvs_end_to_end)$}"
+TSAN_GTEST_FILTER="${TSAN_GTEST_FILTER:-*:-MvsEndToEnd.Ablations:MvsEndToEnd.VaryingLightingAndOccluder}"
+do_asan=1 do_tsan=0
 case "${1:-}" in
-  --asan-only) do_tsan=0 ;;
-  --tsan-only) do_asan=0 ;;
-  "") ;;
+  --tsan) do_tsan=1 ;;
+  --tsan-only) do_asan=0 do_tsan=1 ;;
+  --asan-only | "") ;;
   *) echo "run_sanitizers.sh: unknown option '$1'" >&2; exit 2 ;;
 esac
 SUPP="$ROOT/test/sanitizers"
-launcher=()
-command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 configure() {  # build-dir cmake-args...
   local dir="$1"
   shift
   mkdir -p "$dir"
   cmake -S "$ROOT" -B "$dir" -DWILD_MVS_WITH_ROS=OFF \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
-    "${launcher[@]}" "$@" >"$dir/cmake.log" 2>&1 || { cat "$dir/cmake.log"; return 1; }
+    "${CCACHE_ARGS[@]}" "$@" >"$dir/cmake.log" 2>&1 || { cat "$dir/cmake.log"; return 1; }
+}
+# The build targets of the tests selected by ctest arguments (cli_* tests
+# run the tool).
+test_targets() {  # build-dir ctest-args...
+  local dir="$1"
+  shift
+  ctest --test-dir "$dir" -N "$@" | sed -n 's/^ *Test *#[0-9]*: *//p' |
+    sed 's/^cli_.*/wild_mvs/' | sort -u | tr '\n' ' '
+}
+build() {  # build-dir targets...
+  local dir="$1"
+  shift
+  # shellcheck disable=SC2068
+  cmake --build "$dir" -j"$JOBS" --target $@ >"$dir/build.log" 2>&1 ||
+    { tail -60 "$dir/build.log"; return 1; }
+  # Warnings are checked by the normal (gcc) and fuzz (clang) builds; the
+  # sanitizer build only reports them.
+  if grep -E 'warning:' "$dir/build.log"; then
+    echo "run_sanitizers.sh: build warnings in the sanitizer build (above)" >&2
+  fi
 }
 
 status=0
 if [ "$do_asan" = 1 ]; then
-  echo "run_sanitizers.sh: AddressSanitizer + UBSan build in $ASAN_BUILD_DIR"
+  echo "run_sanitizers.sh: ASan + UBSan build in $ASAN_BUILD_DIR"
   start=$(date +%s)
   configure "$ASAN_BUILD_DIR" -DWILD_MVS_SANITIZE=ON \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1"
-  cmake --build "$ASAN_BUILD_DIR" -j"$JOBS"
+  sel=(-R "$ASAN_TESTS")
+  [ -n "${ASAN_EXCLUDE:-}" ] && sel+=(-E "$ASAN_EXCLUDE")
+  build "$ASAN_BUILD_DIR" "$(test_targets "$ASAN_BUILD_DIR" "${sel[@]}")" wild_mvs
   built=$(date +%s)
   # Leaks are findings too; the suppressions cover third-party libraries only.
   export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
   export LSAN_OPTIONS="suppressions=$SUPP/lsan.supp:print_suppressions=0"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   if ctest --test-dir "$ASAN_BUILD_DIR" --output-on-failure -j"$JOBS" \
-    2>&1 | tee "$ASAN_BUILD_DIR/ctest.log"; then
+    "${sel[@]}" 2>&1 | tee "$ASAN_BUILD_DIR/ctest.log"; then
     :
   else
     status=1
   fi
+  # Findings in child processes (the CLI run by a test) show in the log too.
   if grep -Eq 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$ASAN_BUILD_DIR/ctest.log"; then
     echo "run_sanitizers.sh: sanitizer findings (see $ASAN_BUILD_DIR/ctest.log)"
     status=1
@@ -68,27 +99,29 @@ if [ "$do_tsan" = 1 ]; then
     -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=thread"
-  targets=$(ctest --test-dir "$TSAN_BUILD_DIR" -N -R "$TSAN_TESTS" |
-    sed -n 's/^ *Test *#[0-9]*: *//p')
+  targets="$(test_targets "$TSAN_BUILD_DIR" -R "$TSAN_TESTS")"
   if [ -z "$targets" ]; then
     echo "run_sanitizers.sh: no tests match $TSAN_TESTS"
+    status=1
   else
-    # shellcheck disable=SC2086
-    cmake --build "$TSAN_BUILD_DIR" -j"$JOBS" --target $targets
+    build "$TSAN_BUILD_DIR" "$targets"
     built=$(date +%s)
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$SUPP/tsan.supp"
-    # ctest -j1: TSan tests use every core themselves.
-    if ctest --test-dir "$TSAN_BUILD_DIR" --output-on-failure -R "$TSAN_TESTS" \
-      2>&1 | tee "$TSAN_BUILD_DIR/ctest.log"; then
+    export GTEST_FILTER="$TSAN_GTEST_FILTER"
+    norandom=()
+    setarch -R true 2>/dev/null && norandom=(setarch -R)
+    # ctest -j1: the parallel tests use every core themselves.
+    if "${norandom[@]}" ctest --test-dir "$TSAN_BUILD_DIR" --output-on-failure \
+      -R "$TSAN_TESTS" 2>&1 | tee "$TSAN_BUILD_DIR/ctest.log"; then
       :
     else
       status=1
     fi
-    if grep -q 'WARNING: ThreadSanitizer' "$TSAN_BUILD_DIR/ctest.log"; then
-      echo "run_sanitizers.sh: ThreadSanitizer findings (see $TSAN_BUILD_DIR/ctest.log)"
+    if grep -Eq 'WARNING: ThreadSanitizer|FATAL: ThreadSanitizer' "$TSAN_BUILD_DIR/ctest.log"; then
+      echo "run_sanitizers.sh: ThreadSanitizer findings or failure (see $TSAN_BUILD_DIR/ctest.log)"
       status=1
     fi
-    unset TSAN_OPTIONS
+    unset TSAN_OPTIONS GTEST_FILTER
     echo "run_sanitizers.sh: TSan build $((built - start)) s, tests $(($(date +%s) - built)) s"
   fi
 fi
