@@ -408,11 +408,13 @@ Mesh Read(const std::string& path, bool want_faces) {
           std::vector<int> idx(m);
           for (size_t j = 0; j < m; ++j) {
             const double v = body.Read(p.type, "list entry");
-            idx[j] = static_cast<int>(v);
             if (static_cast<int>(k) == face_list)
               Require(v >= 0 && v < static_cast<double>(c.xyz.size()), path,
                       ": face ", i, " refers to vertex ", v, " but there are ",
                       c.xyz.size(), " vertices");
+            // Entries of other lists are skipped; only in-range values are
+            // converted (a huge or NaN value must not reach the int cast).
+            idx[j] = v >= 0 && v < 2e9 ? static_cast<int>(v) : -1;
           }
           if (static_cast<int>(k) == face_list && want_faces) {
             Require(m >= 3, path, ": face ", i, " has only ", m, " vertices");

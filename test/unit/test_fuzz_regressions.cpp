@@ -15,6 +15,7 @@
 #include "wild_mvs/cli/reconstruct_config.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/io/image_size.h"
+#include "wild_mvs/io/ply.h"
 
 namespace wild_mvs {
 namespace {
@@ -83,6 +84,35 @@ TEST(FuzzRegressions, BmpHeightInt32MinIsRefused) {
   const ImageSize s = ReadImageSize(path);
   EXPECT_EQ(s.width, 2);
   EXPECT_EQ(s.height, 2);
+  std::filesystem::remove_all(dir);
+}
+
+// fuzz_ply, clean CI dry run of 2026-11-30: an ASCII face list entry of
+// 2.2e11 was cast to int before its range check (UBSan: float-cast-overflow
+// in ply.cpp). Now the file is refused, naming it and the face.
+TEST(FuzzRegressions, PlyFaceIndexOverIntMaxIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/wild_mvs_fuzz_ply";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/face.ply";
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << ReadCorpus("ply", "crash_face_index_over_int_max");
+  }
+  for (int mesh = 0; mesh < 2; ++mesh) {
+    try {
+      if (mesh)
+        ReadPlyMesh(path);
+      else
+        ReadPlyCloud(path);
+      ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(path), std::string::npos) << what;
+      // The mesh reader stops earlier, at a face of 0 vertices.
+      if (!mesh)
+        EXPECT_NE(what.find("refers to vertex"), std::string::npos) << what;
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 
