@@ -20,3 +20,24 @@ wild_mvs_build() {  # extra cmake args...
     || { cat "$BUILD_DIR.cmake.log"; return 1; }
   cmake --build "$BUILD_DIR" -j"$JOBS"
 }
+
+# The clang AddressSanitizer + UndefinedBehaviorSanitizer build (default
+# build-fuzz/): library, tool and tests sanitized, the library also with
+# libFuzzer coverage (cmake/fuzz.cmake). scripts/run_sanitizers.sh runs the
+# tests of this build and scripts/run_fuzz.sh its fuzz harnesses; both
+# configure it through this function, identically, so the second one
+# rebuilds nothing. WILD_MVS_FUZZ_ROS=ON|OFF: the ROS message harness
+# (default: when catkin is installed).
+wild_mvs_configure_sanitized() {  # build-dir
+  local dir="$1" ros="${WILD_MVS_FUZZ_ROS:-}"
+  if [ -z "$ros" ]; then
+    ros=OFF
+    [ -f /usr/share/catkin/cmake/catkinConfig.cmake ] && ros=ON
+  fi
+  mkdir -p "$dir"
+  cmake -S "$WILD_MVS_ROOT" -B "$dir" -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+    -DWILD_MVS_FUZZ=ON -DWILD_MVS_WITH_ROS="$ros" -DWILD_MVS_BUILD_TESTS=ON \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
+    "${CCACHE_ARGS[@]}" >"$dir/cmake.log" 2>&1 || { cat "$dir/cmake.log"; return 1; }
+}

@@ -1,28 +1,35 @@
 #!/usr/bin/env bash
 # Sanitizer builds and runs (no findings allowed):
-#  1. ASan + UBSan (default; scripts/run_tests.sh runs it): build-asan/, the
-#     project built with gcc -fsanitize=address,undefined
-#     -fno-sanitize-recover=all (-DWILD_MVS_SANITIZE=ON), ROS off, only the
-#     targets the tests need. Runs every unit and CLI test with ctest
-#     (ASAN_TESTS / ASAN_EXCLUDE select), among them the end-to-end runs on
-#     small rendered scenes: test_mvs_end_to_end (ReconstructView, 1 and 2
-#     threads) and test_cli_reconstruct (`wild_mvs reconstruct` sparse ->
-#     depth -> fuse -> mesh, resumed, bad output folders).
-#  2. ThreadSanitizer (opt-in, --tsan or --tsan-only): build-tsan/, the
-#     parallel code: the fusion tests and the MVS end-to-end test that runs
-#     ReconstructView with 2 threads (TSAN_TESTS, TSAN_GTEST_FILTER). Runs
-#     under `setarch -R` when available (TSan fails on some kernels with
-#     "unexpected memory mapping" when ASLR is on).
+#  1. ASan + UBSan (default; scripts/run_tests.sh runs it): the clang build
+#     that the fuzz harnesses use too (build-fuzz/, configured by
+#     wild_mvs_configure_sanitized in scripts/common.sh: every target built
+#     with -fsanitize=address,undefined -fno-sanitize-recover=undefined).
+#     Runs every ROS-free unit and CLI test with ctest (ASAN_TESTS /
+#     ASAN_EXCLUDE select; the ROS tests are left out: roscpp is not
+#     sanitized), among them the end-to-end runs on small rendered scenes:
+#     test_mvs_end_to_end (ReconstructView, 1 and 2 threads) and
+#     test_cli_reconstruct (`wild_mvs reconstruct` sparse -> depth -> fuse
+#     -> mesh, resumed, bad output folders). Leaks are findings too
+#     (LeakSanitizer; test/sanitizers/lsan.supp lists third-party ones).
+#     A gcc build of the same: cmake -DWILD_MVS_SANITIZE=ON.
+#  2. ThreadSanitizer (opt-in, --tsan or --tsan-only; WILD_MVS_TSAN=1 for
+#     scripts/run_tests.sh): build-tsan/, the parallel code: the fusion
+#     tests and the MVS end-to-end test that runs ReconstructView with 2
+#     threads (TSAN_TESTS, TSAN_GTEST_FILTER). Runs under `setarch -R` when
+#     available (TSan fails on some kernels with "unexpected memory mapping"
+#     when ASLR is on).
 # Usage: scripts/run_sanitizers.sh [--tsan|--tsan-only]
-# Environment: JOBS (default: cores), ASAN_BUILD_DIR, TSAN_BUILD_DIR,
-#   ASAN_TESTS (ctest -R regex, default all), ASAN_EXCLUDE (ctest -E regex),
-#   TSAN_TESTS (ctest -R regex), TSAN_GTEST_FILTER.
+# Environment: JOBS (default: cores), FUZZ_BUILD_DIR (the ASan build,
+#   default build-fuzz), TSAN_BUILD_DIR, ASAN_TESTS (ctest -R regex, default
+#   all), ASAN_EXCLUDE (ctest -E regex, default the ROS tests), TSAN_TESTS
+#   (ctest -R regex), TSAN_GTEST_FILTER.
 set -eo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 source "$ROOT/scripts/common.sh"
-ASAN_BUILD_DIR="${ASAN_BUILD_DIR:-$ROOT/build-asan}"
+ASAN_BUILD_DIR="${FUZZ_BUILD_DIR:-$ROOT/build-fuzz}"
 TSAN_BUILD_DIR="${TSAN_BUILD_DIR:-$ROOT/build-tsan}"
 ASAN_TESTS="${ASAN_TESTS:-.}"
+ASAN_EXCLUDE="${ASAN_EXCLUDE:-^(_ctest_|ros_)}"
 TSAN_TESTS="${TSAN_TESTS:-^test_(fusion|fusion_synthetic|mvs_end_to_end)$}"
 TSAN_GTEST_FILTER="${TSAN_GTEST_FILTER:-*:-MvsEndToEnd.Ablations:MvsEndToEnd.VaryingLightingAndOccluder}"
 do_asan=1 do_tsan=0
@@ -66,10 +73,9 @@ status=0
 if [ "$do_asan" = 1 ]; then
   echo "run_sanitizers.sh: ASan + UBSan build in $ASAN_BUILD_DIR"
   start=$(date +%s)
-  configure "$ASAN_BUILD_DIR" -DWILD_MVS_SANITIZE=ON \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1"
+  wild_mvs_configure_sanitized "$ASAN_BUILD_DIR"
   sel=(-R "$ASAN_TESTS")
-  [ -n "${ASAN_EXCLUDE:-}" ] && sel+=(-E "$ASAN_EXCLUDE")
+  [ -n "$ASAN_EXCLUDE" ] && sel+=(-E "$ASAN_EXCLUDE")
   build "$ASAN_BUILD_DIR" "$(test_targets "$ASAN_BUILD_DIR" "${sel[@]}")" wild_mvs
   built=$(date +%s)
   # Leaks are findings too; the suppressions cover third-party libraries only.

@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # Runs every test: installs what is missing (Debian 12 packages), builds,
-# runs the unit, CLI and ROS tests with ctest, then the deterministic fuzz
-# step of every reader (scripts/run_fuzz.sh: clang ASan/UBSan build in
-# build-fuzz/; replays the committed corpus and regressions, then a fixed
-# number of executions per harness with a fixed seed), and the sanitizer
-# step (scripts/run_sanitizers.sh: gcc ASan + UBSan build in build-asan/, ROS
-# off, running the unit and CLI tests again). WILD_MVS_TSAN=1 adds the
-# ThreadSanitizer run of the parallel code; WILD_MVS_NO_SANITIZERS=1 and
-# WILD_MVS_NO_FUZZ=1 skip those steps.
+# runs the unit, CLI and ROS tests with ctest, then the hardening steps on
+# one clang AddressSanitizer + UndefinedBehaviorSanitizer build (build-fuzz/):
+#  - scripts/run_sanitizers.sh: the ROS-free unit and CLI tests again in
+#    that build (among them end-to-end reconstructions of rendered scenes),
+#    no sanitizer report or leak allowed;
+#  - scripts/run_fuzz.sh: every reader's fuzz harness, bounded: the
+#    committed corpus and regressions replayed, then a fixed number of
+#    executions per harness with a fixed seed.
+# WILD_MVS_TSAN=1 adds the ThreadSanitizer run of the parallel depth and
+# fusion code (build-tsan/, about 5 more minutes); WILD_MVS_NO_SANITIZERS=1
+# and WILD_MVS_NO_FUZZ=1 skip those steps.
 # Usage: scripts/run_tests.sh
 set -eo pipefail
 source "$(dirname "$0")/common.sh"
