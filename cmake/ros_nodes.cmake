@@ -46,7 +46,9 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
     set(name ros_${name})
     add_executable(${name} ${src})
     target_link_libraries(${name} PRIVATE wild_mvs_ros wild_mvs_test_support
-      GTest::gtest GTest::gtest_main)
+      yaml-cpp GTest::gtest GTest::gtest_main)
+    target_compile_definitions(${name} PRIVATE
+      WILD_MVS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
     target_compile_options(${name} PRIVATE ${WILD_MVS_WARNINGS})
     add_test(NAME ${name} COMMAND ${name})
     set_tests_properties(${name} PROPERTIES TIMEOUT 300)

@@ -63,8 +63,9 @@ if [ "$rc" != 0 ] || [ ! -s "$OUT/cloud.ply" ] || [ -z "$saved" ]; then
   exit 1
 fi
 points=$(sed -n 's/^wild_mvs: saved \([0-9]*\) points.*/\1/p' <<<"$saved")
-keyframes=$(sed -n 's/.* \([0-9]*\) keyframes.*/\1/p' <<<"$depth")
+keyframes=$(sed -n 's/.* \([0-9]*\) keyframes, .*/\1/p' <<<"$depth")
 maps=$(sed -n 's/.* \([0-9]*\) depth maps.*/\1/p' <<<"$depth")
 dropped=$(sed -n 's/.* \([0-9]*\) frames dropped.*/\1/p' <<<"$depth")
+evicted=$(sed -n 's/.* \([0-9]*\) keyframes evicted.*/\1/p' <<<"$depth")
 grep -h "peak RSS" "$OUT/roslaunch.log" | sed 's/^/  /' || true
-echo "ros_reconstruct: $(basename "$DATASET"): ${keyframes:-?} keyframes, ${maps:-?} depth maps, ${points:-?} cloud points, ${dropped:-?} frames dropped; saved $OUT/cloud.ply; ${seconds} s (bag, nodes, save)"
+echo "ros_reconstruct: $(basename "$DATASET"): ${keyframes:-?} keyframes, ${maps:-?} depth maps, ${points:-?} cloud points, ${dropped:-?} frames dropped, ${evicted:-?} keyframes evicted before a depth map; saved $OUT/cloud.ply; ${seconds} s (bag, nodes, save)"

@@ -68,6 +68,30 @@ struct DepthNode::Impl {
 
   double last_stamp = -1;  // front end only
   std::atomic<uint64_t> reset_count{0};
+  std::atomic<uint64_t> evictions_reported{0};
+  DropCounter evictions;  // throttles the warning below
+
+  // Warns (throttled) when keyframes were evicted from the full keyframe
+  // store before their depth map was made: reconstruction is slower than
+  // keyframes arrive. They are counted in diagnostics and in the summary.
+  void ReportEvictions() {
+    const uint64_t total = stream->Stats().evicted_waiting;
+    uint64_t seen = evictions_reported.load();
+    while (seen < total &&
+           !evictions_reported.compare_exchange_weak(seen, total)) {
+    }
+    if (seen >= total) return;
+    if (evictions.Count("evicted", nullptr))
+      ROS_WARN(
+          "%s: keyframe store full: %lu keyframes so far evicted before "
+          "their depth map (depth maps are made slower than keyframes "
+          "arrive; max_keyframes = %d, max_keyframe_mb = %.0f: raise them, "
+          "lower the frame rate or keyframe_min_baseline; throttled to one "
+          "message per %.0f s)",
+          pnh.getNamespace().c_str(), static_cast<unsigned long>(total),
+          options.stream.store.max_keyframes, options.stream.store.max_mb,
+          options.error_throttle);
+  }
 
   std::string Topic(const std::string& name) const {
     return nh.resolveName(name);
@@ -291,6 +315,7 @@ struct DepthNode::Impl {
       Drop(image_topic, "rejected frame", e.what());
       return;
     }
+    ReportEvictions();
     switch (status) {
       case StreamReconstructor::FrameStatus::kOutOfOrder:
         Drop(image_topic, "stamp out of order (not after the previous frame)");
@@ -374,10 +399,13 @@ struct DepthNode::Impl {
       recv = received;
     }
     const uint64_t dropped = drops.Total();
-    if (dropped > 0) {
+    ReportEvictions();
+    if (dropped > 0 || s.evicted_waiting > 0) {
       stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
-                    "%lu frames dropped (see dropped: entries)",
-                    static_cast<unsigned long>(dropped));
+                    "%lu frames dropped (see dropped: entries), %lu "
+                    "keyframes evicted before reconstruction",
+                    static_cast<unsigned long>(dropped),
+                    static_cast<unsigned long>(s.evicted_waiting));
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
     }
@@ -416,6 +444,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     ROS_WARN("%s: unknown parameter '%s' (ignored; see config/depth_node.yaml)",
              pnh.getNamespace().c_str(), n.c_str());
   m.drops.set_throttle(m.options.error_throttle);
+  m.evictions.set_throttle(m.options.error_throttle);
   const DepthNodeOptions& o = m.options;
 
   m.stream = std::make_unique<StreamReconstructor>(
@@ -485,11 +514,13 @@ DepthNode::~DepthNode() {
   const StreamStats s = m.stream->Stats();
   std::fprintf(stderr,
                "depth node: %lu frames received, %lu keyframes, %lu depth "
-               "maps, %lu frames dropped, %lu stream resets\n",
+               "maps, %lu frames dropped, %lu keyframes evicted before a "
+               "depth map, %lu stream resets\n",
                static_cast<unsigned long>(m.received),
                static_cast<unsigned long>(s.keyframes_total),
                static_cast<unsigned long>(s.reconstructed),
                static_cast<unsigned long>(m.drops.Total()),
+               static_cast<unsigned long>(s.evicted_waiting),
                static_cast<unsigned long>(s.resets));
   m.stream.reset();
 }

@@ -45,12 +45,18 @@ class Binder {
   void Bind(const std::string& name, T* field) {
     names_.push_back(name);
     src_.Get(name, field);
+    values_[name] = ParamSource::Value(*field);
   }
   const std::vector<std::string>& names() const { return names_; }
+  // Every bound parameter's value after reading (the default when unset).
+  const std::map<std::string, ParamSource::Value>& values() const {
+    return values_;
+  }
 
  private:
   const ParamSource& src_;
   std::vector<std::string> names_;
+  std::map<std::string, ParamSource::Value> values_;
 };
 
 void BindMvs(Binder& b, MvsOptions* m) {
@@ -306,6 +312,28 @@ FusionNodeOptions ReadFusionNodeOptions(const ParamSource& params) {
   BindFusionNode(b, &o);
   CheckOptions(o, params);
   return o;
+}
+
+namespace {
+// Every bound parameter's value after reading `params` into fresh options.
+template <typename Options, typename BindFn>
+std::map<std::string, ParamSource::Value> Values(const ParamSource& params,
+                                                 BindFn bind) {
+  Options o;
+  Binder b(params);
+  bind(b, &o);
+  return b.values();
+}
+}  // namespace
+
+std::map<std::string, ParamSource::Value> DepthNodeParamValues(
+    const ParamSource& params) {
+  return Values<DepthNodeOptions>(params, BindDepth);
+}
+
+std::map<std::string, ParamSource::Value> FusionNodeParamValues(
+    const ParamSource& params) {
+  return Values<FusionNodeOptions>(params, BindFusionNode);
 }
 
 std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params) {

@@ -1,5 +1,9 @@
 // Copyright wild_mvs authors. ROS parameters -> option structs.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <functional>
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/ros/params.h"
@@ -54,6 +58,67 @@ TEST(Params, ValuesReachTheCoreOptions) {
   EXPECT_EQ(f.output_path, "/tmp/x.ply");
   EXPECT_EQ(f.fusion.min_support, 2);
   EXPECT_DOUBLE_EQ(f.fusion.depth_tolerance, 0.02);
+}
+
+// config/<node>.yaml as "a/b" -> scalar text.
+std::map<std::string, std::string> FlatYaml(const std::string& file) {
+  std::map<std::string, std::string> out;
+  std::function<void(const YAML::Node&, const std::string&)> walk =
+      [&](const YAML::Node& n, const std::string& prefix) {
+        for (const auto& kv : n) {
+          const std::string key = prefix + kv.first.as<std::string>();
+          if (kv.second.IsMap())
+            walk(kv.second, key + "/");
+          else
+            out[key] = kv.second.as<std::string>();
+        }
+      };
+  walk(YAML::LoadFile(file), "");
+  return out;
+}
+
+// The config files say "defaults shown": every parameter of the node is in
+// its file with the value the node uses when the parameter is unset.
+void ExpectYamlShowsDefaults(
+    const std::string& file,
+    const std::map<std::string, ParamSource::Value>& defaults) {
+  const auto yaml = FlatYaml(file);
+  for (const auto& [name, value] : defaults) {
+    SCOPED_TRACE(file + ": " + name);
+    auto it = yaml.find(name);
+    ASSERT_NE(it, yaml.end()) << "parameter missing from the file";
+    const std::string& text = it->second;
+    if (auto* b = std::get_if<bool>(&value)) {
+      EXPECT_EQ(text, *b ? "true" : "false");
+    } else if (auto* i = std::get_if<int>(&value)) {
+      EXPECT_DOUBLE_EQ(std::stod(text), *i);
+    } else if (auto* d = std::get_if<double>(&value)) {
+      EXPECT_DOUBLE_EQ(std::stod(text), *d);
+    } else {
+      EXPECT_EQ(text, std::get<std::string>(value));
+    }
+  }
+  for (const auto& [name, text] : yaml)
+    EXPECT_TRUE(defaults.count(name)) << file << ": unknown key " << name;
+}
+
+TEST(Params, ConfigFilesShowTheDefaults) {
+  const std::string dir = std::string(WILD_MVS_SOURCE_DIR) + "/config/";
+  MapParamSource none;
+  ExpectYamlShowsDefaults(dir + "depth_node.yaml", DepthNodeParamValues(none));
+  ExpectYamlShowsDefaults(dir + "fusion_node.yaml",
+                          FusionNodeParamValues(none));
+  // The fusion node's memory budgets are below the core's (CLI) defaults.
+  const auto f = FusionNodeParamValues(none);
+  EXPECT_DOUBLE_EQ(std::get<double>(f.at("map_store_mb")), 256.0);
+  EXPECT_LT(std::get<double>(f.at("fusion/map_cache_mb")),
+            FusionOptions().map_cache_mb);
+  EXPECT_LT(std::get<double>(f.at("fusion/pending_mb")),
+            FusionOptions().pending_mb);
+  // Values read from parameters are reported as read.
+  const auto set =
+      FusionNodeParamValues(MapParamSource({{"fusion/pending_mb", 32.0}}));
+  EXPECT_DOUBLE_EQ(std::get<double>(set.at("fusion/pending_mb")), 32.0);
 }
 
 std::string ErrorOf(const MapParamSource& p) {

@@ -111,16 +111,34 @@ struct FusionNodeOptions {
   // Depth maps held in memory for the consistency checks; older ones are
   // spilled to spill_dir (a temporary folder when empty) and read back when
   // needed, so memory stays bounded on long runs.
-  double map_store_mb = 512;
+  double map_store_mb = 256;
   std::string spill_dir;
-  FusionOptions fusion;  // the core's fusion options
+  // The core's fusion options, with the node's smaller memory budgets (the
+  // node shares its robot with other processes): map cache 256 MB (the
+  // core's default 512), pending samples 128 MB (256). With map_store_mb the
+  // node's bounded memory is 640 MB plus the cloud.
+  FusionOptions fusion = NodeFusionDefaults();
   void Check() const;
+
+  static FusionOptions NodeFusionDefaults() {
+    FusionOptions f;
+    f.map_cache_mb = 256;
+    f.pending_mb = 128;
+    return f;
+  }
 };
 
 // Reads the options (defaults for unset parameters), checks them, and throws
 // Error naming "<where>/~<param>" on a bad value.
 DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params);
 FusionNodeOptions ReadFusionNodeOptions(const ParamSource& params);
+// Every parameter of the node with its value (the default when `params`
+// does not set it), e.g. "fusion/map_cache_mb" -> 256.0. config/*.yaml
+// shows these defaults (a test compares them).
+std::map<std::string, ParamSource::Value> DepthNodeParamValues(
+    const ParamSource& params);
+std::map<std::string, ParamSource::Value> FusionNodeParamValues(
+    const ParamSource& params);
 // Private parameters that the node does not know (typos), e.g.
 // "keyframe_min_angel".
 std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params);
