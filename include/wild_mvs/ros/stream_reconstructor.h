@@ -42,7 +42,7 @@ struct StreamOptions {
   KeyframeStoreOptions store;
   // Threads inside one reconstruction (image tiles). Reconstructions run one
   // at a time on a dispatcher thread, never on the caller's thread.
-  int num_threads = 1;
+  int num_threads = 2;   // config/depth_node.yaml shows the same
   int max_pending = 2;   // reconstructions queued or running; more wait
   int worker_index = 0;  // this worker owns keyframes with
   int worker_count = 1;  // id % worker_count == worker_index
