@@ -15,7 +15,7 @@
 # docs/$SOAK_DOCS_NAME, when SOAK_UPDATE_DOCS=1), OUT_DIR/summary.txt, node
 # logs, the final cloud OUT_DIR/cloud.ply.
 # SOAK_FUSION_MB=N sets the fusion node's memory bounds (map_store_mb,
-# fusion/map_cache_mb, fusion/pending_mb; defaults 512, 512, 256) to N MB
+# fusion/map_cache_mb, fusion/pending_mb; defaults 256, 256, 128) to N MB
 # each, so that their plateau shows within the run.
 # Runs under nice -n 10. Needs a ROS build (scripts/common.sh wild_mvs_build).
 set -eo pipefail
