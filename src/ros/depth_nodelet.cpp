@@ -74,8 +74,8 @@ struct DepthNode::Impl {
   // Warns (throttled) when keyframes were evicted from the full keyframe
   // store before their depth map was made: reconstruction is slower than
   // keyframes arrive. They are counted in diagnostics and in the summary.
-  void ReportEvictions() {
-    const uint64_t total = stream->Stats().evicted_waiting;
+  // `total`: StreamStats::evicted_waiting.
+  void ReportEvictions(uint64_t total) {
     uint64_t seen = evictions_reported.load();
     while (seen < total &&
            !evictions_reported.compare_exchange_weak(seen, total)) {
@@ -315,7 +315,7 @@ struct DepthNode::Impl {
       Drop(image_topic, "rejected frame", e.what());
       return;
     }
-    ReportEvictions();
+    ReportEvictions(stream->Stats().evicted_waiting);
     switch (status) {
       case StreamReconstructor::FrameStatus::kOutOfOrder:
         Drop(image_topic, "stamp out of order (not after the previous frame)");
@@ -399,7 +399,7 @@ struct DepthNode::Impl {
       recv = received;
     }
     const uint64_t dropped = drops.Total();
-    ReportEvictions();
+    ReportEvictions(s.evicted_waiting);
     if (dropped > 0 || s.evicted_waiting > 0) {
       stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
                     "%lu frames dropped (see dropped: entries), %lu "
