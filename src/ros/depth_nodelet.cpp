@@ -3,6 +3,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
+#include <image_transport/camera_common.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
@@ -20,9 +21,11 @@
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <opencv2/calib3d.hpp>
 #include <pluginlib/class_list_macros.hpp>
+#include <set>
 #include <thread>
 
 #include "wild_mvs/core/error.h"
@@ -33,6 +36,14 @@
 
 namespace wild_mvs {
 namespace ros1 {
+// TEMP-MERGE: until conversions.h has them.
+static std::string StripLeadingSlash(const std::string& f) {
+  const size_t n = f.find_first_not_of('/');
+  return n == std::string::npos ? std::string() : f.substr(n);
+}
+static sensor_msgs::Image DepthToMsg16(const cv::Mat& d) {
+  return DepthToMsg(d);
+}
 
 struct DepthNode::Impl {
   struct Frame {
@@ -48,12 +59,19 @@ struct DepthNode::Impl {
   DropCounter drops;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener;
-  std::unique_ptr<image_transport::ImageTransport> it;
+  std::unique_ptr<image_transport::ImageTransport> it, private_it;
   image_transport::Subscriber image_sub;
   ros::Subscriber compressed_sub, info_sub, pose_sub, points_sub;
-  ros::Publisher depth_pub, confidence_pub, normals_pub, info_pub, points_pub,
-      view_pub;
-  ros::Timer tick_timer, diag_timer;
+  // REP 118 camera pairs (image_transport CameraPublisher: ~depth/image_rect
+  // + ~depth/camera_info, ~confidence/image + ~confidence/camera_info).
+  image_transport::CameraPublisher depth_pub, confidence_pub;
+  image_transport::Publisher normals_pub;
+  ros::Publisher points_pub, view_pub;
+  // Periodic work about machine time (scheduling, diagnostics): steady
+  // timers, so that it goes on when /clock pauses or stops (sim time).
+  ros::SteadyTimer tick_timer, diag_timer;
+  std::string image_topic, info_topic;  // resolved input names
+  bool rectified = false;               // camera from P, D ignored
   std::unique_ptr<diagnostic_updater::Updater> updater;
   std::unique_ptr<StreamReconstructor> stream;
 
@@ -61,6 +79,9 @@ struct DepthNode::Impl {
   std::condition_variable cv;
   std::deque<Frame> queue;
   sensor_msgs::CameraInfoConstPtr latest_info;
+  // Recent camera_infos by exact stamp (ns), for pairing with images.
+  std::map<uint64_t, sensor_msgs::CameraInfoConstPtr> infos;
+  std::set<std::string> slash_warned;  // frame ids warned about once
   std::deque<geometry_msgs::PoseStampedConstPtr> poses;
   bool stop = false;
   uint64_t received = 0;
@@ -117,7 +138,6 @@ struct DepthNode::Impl {
     {
       std::lock_guard<std::mutex> lock(mutex);
       ++received;
-      f.info = latest_info;
       if (static_cast<int>(queue.size()) >= options.input_queue_size) {
         queue.pop_front();
         dropped = true;
@@ -129,6 +149,24 @@ struct DepthNode::Impl {
       Drop(Topic("image") +
                (options.image_transport == "raw" ? "" : "/compressed"),
            "input queue full (frames arrive faster than they are processed)");
+  }
+
+  // A frame id as tf2 wants it: without leading '/' (tf2 rejects them, and
+  // many recorded bags have them); warns once per frame id.
+  std::string NoSlash(const std::string& frame_id) {
+    const std::string stripped = StripLeadingSlash(frame_id);
+    if (stripped == frame_id) return frame_id;
+    bool first = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      first = slash_warned.insert(frame_id).second;
+    }
+    if (first)
+      ROS_WARN(
+          "%s: frame id '%s' starts with '/', which tf2 does not accept: "
+          "using '%s' (warned once per frame id)",
+          pnh.getNamespace().c_str(), frame_id.c_str(), stripped.c_str());
+    return stripped;
   }
 
   void OnImage(const sensor_msgs::ImageConstPtr& msg) {
@@ -149,8 +187,43 @@ struct DepthNode::Impl {
     {
       std::lock_guard<std::mutex> lock(mutex);
       latest_info = msg;
+      infos[msg->header.stamp.toNSec()] = msg;
+      while (infos.size() > 100) infos.erase(infos.begin());
     }
     cv.notify_all();
+  }
+
+  // The camera_info for a frame: the one with the frame's exact stamp
+  // (waiting up to tf_timeout of wall time for it), or with
+  // camera_info_latest the latest one. Null (and counted) when none.
+  sensor_msgs::CameraInfoConstPtr InfoFor(const Frame& f) {
+    const uint64_t key = f.stamp.toNSec();
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration<double>(options.tf_timeout);
+    std::unique_lock<std::mutex> lock(mutex);
+    auto ready = [&] {
+      if (stop) return true;
+      if (options.camera_info_latest) return latest_info != nullptr;
+      return infos.count(key) > 0;
+    };
+    cv.wait_until(lock, deadline, ready);
+    if (options.camera_info_latest) {
+      if (latest_info) return latest_info;
+      lock.unlock();
+      Drop(info_topic, "no camera_info received yet");
+      return nullptr;
+    }
+    auto it_info = infos.find(key);
+    if (it_info != infos.end()) return it_info->second;
+    const bool any = !infos.empty();
+    lock.unlock();
+    Drop(info_topic,
+         any ? "no camera_info with the image's stamp (images and "
+               "camera_info are paired by exact stamp; set "
+               "camera_info_latest:=true for a driver that publishes it "
+               "once or at another rate)"
+             : "no camera_info received yet");
+    return nullptr;
   }
   void OnPose(const geometry_msgs::PoseStampedConstPtr& msg) {
     {
@@ -161,7 +234,7 @@ struct DepthNode::Impl {
     cv.notify_all();
   }
   void OnSparsePoints(const wild_mvs::SparsePointsConstPtr& msg) {
-    if (msg->header.frame_id != options.world_frame) {
+    if (NoSlash(msg->header.frame_id) != options.world_frame) {
       Drop(Topic("sparse_points"), "frame_id '" + msg->header.frame_id +
                                        "' is not the world frame '" +
                                        options.world_frame + "'");
@@ -198,8 +271,21 @@ struct DepthNode::Impl {
       }
       geometry_msgs::TransformStamped T;
       try {
-        T = tf_buffer->lookupTransform(options.world_frame, f.frame_id, f.stamp,
-                                       ros::Duration(options.tf_timeout));
+        // Wait in wall time (tf2's own timeout runs on ROS time, which
+        // stands still when /clock pauses), polling the buffer.
+        const auto deadline = std::chrono::steady_clock::now() +
+                              std::chrono::duration<double>(options.tf_timeout);
+        while (!tf_buffer->canTransform(options.world_frame, f.frame_id,
+                                        f.stamp) &&
+               std::chrono::steady_clock::now() < deadline) {
+          {
+            std::lock_guard<std::mutex> lock(mutex);
+            if (stop) break;
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        T = tf_buffer->lookupTransform(options.world_frame, f.frame_id,
+                                       f.stamp);
       } catch (const tf2::TransformException& e) {
         Drop("tf",
              "no transform " + options.world_frame + " <- " + f.frame_id +
@@ -239,7 +325,7 @@ struct DepthNode::Impl {
            "stamp within tf_timeout");
       return false;
     }
-    if (best->header.frame_id != options.world_frame) {
+    if (NoSlash(best->header.frame_id) != options.world_frame) {
       Drop(Topic("pose"), "pose frame_id '" + best->header.frame_id +
                               "' is not the world frame '" +
                               options.world_frame + "'");
@@ -256,20 +342,12 @@ struct DepthNode::Impl {
 
   void Process(Frame f) {
     const std::string image_topic =
-        Topic("image") + (f.raw ? "" : "/compressed");
-    if (!f.info) {
-      // The very first image may come before the first camera_info (other
-      // connection): wait for one as long as for a pose.
-      const auto deadline = std::chrono::steady_clock::now() +
-                            std::chrono::duration<double>(options.tf_timeout);
-      std::unique_lock<std::mutex> lock(mutex);
-      cv.wait_until(lock, deadline, [this] { return stop || latest_info; });
-      f.info = latest_info;
-    }
-    if (!f.info) {
-      Drop(Topic("camera_info"), "no camera_info received yet");
-      return;
-    }
+        this->image_topic + (f.raw ? "" : "/" + options.image_transport);
+    // The camera's optical frame: ~camera_frame, else the image's.
+    f.frame_id = NoSlash(options.camera_frame.empty() ? f.frame_id
+                                                      : options.camera_frame);
+    f.info = InfoFor(f);
+    if (!f.info) return;
     const double stamp = f.stamp.toSec();
     if (last_stamp >= 0 && stamp <= last_stamp &&
         last_stamp - stamp <= options.stream.stamp_reset_threshold) {
@@ -281,7 +359,7 @@ struct DepthNode::Impl {
     try {
       CameraFromCameraInfo(*f.info, &cam, &dist);
     } catch (const Error& e) {
-      Drop(Topic("camera_info"), "invalid camera_info", e.what());
+      Drop(info_topic, "invalid camera_info", e.what());
       return;
     }
     cv::Mat image;
@@ -310,7 +388,7 @@ struct DepthNode::Impl {
     if (!LookupPose(f, &cam)) return;
     StreamReconstructor::FrameStatus status;
     try {
-      status = stream->AddFrame(stamp, f.frame_id, cam, image);
+      status = stream->AddFrame(f.stamp.toNSec(), f.frame_id, cam, image);
     } catch (const Error& e) {
       Drop(image_topic, "rejected frame", e.what());
       return;
@@ -352,28 +430,42 @@ struct DepthNode::Impl {
   }
 
   void Publish(const StreamResult& r) {
+    // Stamps pass through bit for bit (ns), never through a double.
     std_msgs::Header header;
-    header.stamp = ros::Time(r.stamp);
+    header.stamp.fromNSec(r.stamp_ns);
     header.frame_id = r.frame_id;
     auto view = boost::make_shared<wild_mvs::DepthView>();
     view->header = header;
     view->keyframe_id = r.keyframe_id;
-    view->session = ros::Time(r.session);
+    view->session.fromNSec(r.session_ns);
     view->neighbor_ids = r.neighbor_ids;
-    for (double s : r.neighbor_stamps)
-      view->neighbor_stamps.push_back(ros::Time(s));
+    for (uint64_t s : r.neighbor_stamps_ns) {
+      ros::Time t;
+      t.fromNSec(s);
+      view->neighbor_stamps.push_back(t);
+    }
     view->worker_index = options.stream.worker_index;
     view->revision = r.revision;
     FillDepthView(r.depth, options.world_frame, view.get());
     if (!r.image.empty())
       view->image = ColorToMsg(r.image, r.depth.width(), r.depth.height());
     view->image.header = header;
-    // Lazy outputs: only built / sent when someone listens.
-    if (depth_pub.getNumSubscribers() > 0) depth_pub.publish(view->depth);
+    // Lazy outputs: only built / sent when someone listens. Every image
+    // and camera_info has the source image's header (stamp and frame).
+    view->depth.header = view->confidence.header = view->normals.header =
+        view->camera_info.header = header;
+    if (depth_pub.getNumSubscribers() > 0) {
+      if (options.depth_encoding == "16UC1") {
+        sensor_msgs::Image mm = DepthToMsg16(r.depth.depth);
+        mm.header = header;
+        depth_pub.publish(mm, view->camera_info);
+      } else {
+        depth_pub.publish(view->depth, view->camera_info);
+      }
+    }
     if (confidence_pub.getNumSubscribers() > 0)
-      confidence_pub.publish(view->confidence);
+      confidence_pub.publish(view->confidence, view->camera_info);
     if (normals_pub.getNumSubscribers() > 0) normals_pub.publish(view->normals);
-    if (info_pub.getNumSubscribers() > 0) info_pub.publish(view->camera_info);
     if (points_pub.getNumSubscribers() > 0) {
       sensor_msgs::PointCloud2 pc =
           CloudToMsg(DepthMapToCloud(r.depth, r.image));
@@ -443,6 +535,10 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   for (const std::string& n : UnknownDepthNodeParams(params))
     ROS_WARN("%s: unknown parameter '%s' (ignored; see config/depth_node.yaml)",
              pnh.getNamespace().c_str(), n.c_str());
+  // Frame ids as tf2 wants them (leading '/' stripped, warned once).
+  m.options.world_frame = m.NoSlash(m.options.world_frame);
+  if (!m.options.camera_frame.empty())
+    m.options.camera_frame = m.NoSlash(m.options.camera_frame);
   m.drops.set_throttle(m.options.error_throttle);
   m.evictions.set_throttle(m.options.error_throttle);
   const DepthNodeOptions& o = m.options;
@@ -453,10 +549,10 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
         m.Drop("reconstruction", "keyframe failed", e);
       });
 
-  m.depth_pub = m.pnh.advertise<sensor_msgs::Image>("depth", 2);
-  m.confidence_pub = m.pnh.advertise<sensor_msgs::Image>("confidence", 2);
-  m.normals_pub = m.pnh.advertise<sensor_msgs::Image>("normals", 2);
-  m.info_pub = m.pnh.advertise<sensor_msgs::CameraInfo>("depth_camera_info", 2);
+  m.private_it = std::make_unique<image_transport::ImageTransport>(m.pnh);
+  m.depth_pub = m.private_it->advertiseCamera("depth/image_rect", 2);
+  m.confidence_pub = m.private_it->advertiseCamera("confidence/image", 2);
+  m.normals_pub = m.private_it->advertise("normals/image", 2);
   m.points_pub = m.pnh.advertise<sensor_msgs::PointCloud2>("points", 2);
   m.view_pub = m.pnh.advertise<wild_mvs::DepthView>("depth_view", 20);
 
@@ -470,32 +566,61 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   if (o.sparse_source == "topic")
     m.points_sub =
         m.nh.subscribe("sparse_points", 2, &Impl::OnSparsePoints, &m);
-  m.info_sub = m.nh.subscribe("camera_info", 5, &Impl::OnInfo, &m);
-  if (o.image_transport == "raw") {
-    m.it = std::make_unique<image_transport::ImageTransport>(m.nh);
-    m.image_sub = m.it->subscribe("image", 5, &Impl::OnImage, &m,
-                                  image_transport::TransportHints("raw"));
+  // Inputs. camera_info sits beside the image (image_transport's
+  // CameraSubscriber convention) unless `camera_info` is remapped itself.
+  m.image_topic = m.nh.resolveName("image");
+  m.info_topic = m.nh.resolveName("camera_info");
+  if (m.info_topic == m.nh.resolveName("camera_info", false))
+    m.info_topic = image_transport::getCameraInfoTopic(m.image_topic);
+  auto ends_with = [](const std::string& s, const std::string& tail) {
+    return s.size() >= tail.size() &&
+           s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  m.rectified = o.rectified || ends_with(m.image_topic, "/image_rect") ||
+                ends_with(m.image_topic, "/image_rect_color");
+  m.info_sub = m.nh.subscribe(m.info_topic, 20, &Impl::OnInfo, &m);
+  m.it = std::make_unique<image_transport::ImageTransport>(m.nh);
+  const std::vector<std::string> plugins = m.it->getLoadableTransports();
+  const bool have_plugin = std::find(plugins.begin(), plugins.end(),
+                                     o.image_transport) != plugins.end();
+  if (o.image_transport == "raw" || have_plugin) {
+    m.image_sub = m.it->subscribe(m.image_topic, 5, &Impl::OnImage, &m,
+                                  image_transport::TransportHints(
+                                      o.image_transport, ros::TransportHints(),
+                                      m.pnh, "image_transport_hints"));
+  } else if (o.image_transport == "compressed") {
+    // No compressed plugin installed (Debian 12 ships none): take
+    // <image>/compressed and decode it here. "image" is remapped as a
+    // whole name, so it is resolved before appending.
+    m.compressed_sub = m.nh.subscribe(m.image_topic + "/compressed", 5,
+                                      &Impl::OnCompressed, &m);
   } else {
-    // <image>/compressed, as image_transport names it: "image" is
-    // remapped as a whole name, so resolve it before appending.
-    m.compressed_sub = m.nh.subscribe(m.nh.resolveName("image") + "/compressed",
-                                      5, &Impl::OnCompressed, &m);
+    std::string names;
+    for (const std::string& p : plugins) names += " " + p;
+    throw Error(Msg("image_transport = '", o.image_transport,
+                    "': no such image_transport plugin is installed "
+                    "(loadable:",
+                    names, ")"));
   }
 
   m.updater = std::make_unique<diagnostic_updater::Updater>(
       m.nh, m.pnh, m.pnh.getNamespace());
   m.updater->setHardwareID("wild_mvs_depth");
   m.updater->add("depth_node", &m, &Impl::Diagnose);
-  m.diag_timer = m.nh.createTimer(
-      ros::Duration(o.diagnostics_period),
-      [&m](const ros::TimerEvent&) { m.updater->force_update(); });
-  m.tick_timer = m.nh.createTimer(
-      ros::Duration(0.2), [&m](const ros::TimerEvent&) { m.stream->Tick(); });
+  m.diag_timer = m.nh.createSteadyTimer(
+      ros::WallDuration(o.diagnostics_period),
+      [&m](const ros::SteadyTimerEvent&) { m.updater->force_update(); });
+  m.tick_timer = m.nh.createSteadyTimer(
+      ros::WallDuration(0.2),
+      [&m](const ros::SteadyTimerEvent&) { m.stream->Tick(); });
   m.frontend = std::thread([&m] { m.FrontEnd(); });
   ROS_INFO(
-      "%s: worker %d of %d, pose from %s, sparse points from %s, world "
-      "frame '%s'",
+      "%s: worker %d of %d, images %s (%s%s), camera_info %s (%s), pose "
+      "from %s, sparse points from %s, world frame '%s'",
       pnh.getNamespace().c_str(), o.stream.worker_index, o.stream.worker_count,
+      m.image_topic.c_str(), o.image_transport.c_str(),
+      m.rectified ? ", rectified" : "", m.info_topic.c_str(),
+      o.camera_info_latest ? "latest" : "paired by stamp",
       o.pose_source.c_str(), o.sparse_source.c_str(), o.world_frame.c_str());
 }
 

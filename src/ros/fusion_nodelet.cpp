@@ -38,6 +38,11 @@ namespace wild_mvs {
 namespace ros1 {
 
 namespace fs = std::filesystem;
+// TEMP-MERGE
+static std::string StripLeadingSlash(const std::string& f) {
+  const size_t n = f.find_first_not_of('/');
+  return n == std::string::npos ? std::string() : f.substr(n);
+}
 
 struct FusionNode::Impl {
   // A view waiting to be fused, and the maps of fused views.
@@ -62,7 +67,9 @@ struct FusionNode::Impl {
   ros::Subscriber sub;
   ros::Publisher cloud_pub, mesh_pub;
   ros::ServiceServer save_srv, reset_srv;
-  ros::Timer publish_timer, mesh_timer, diag_timer, reorder_timer;
+  // Periodic work about machine time: steady timers, so that the cloud is
+  // still published when /clock pauses or stops (sim time, bag ended).
+  ros::SteadyTimer publish_timer, mesh_timer, diag_timer;
   std::unique_ptr<diagnostic_updater::Updater> updater;
   std::string spill_dir;
   bool own_spill_dir = false;
@@ -90,6 +97,9 @@ struct FusionNode::Impl {
   uint64_t fused = 0, revisions_ignored = 0, spilled = 0, resets = 0;
   uint64_t sessions = 0, session_saves = 0;
   uint64_t cloud_version = 0, published_version = 0, meshed_version = 0;
+  // Stamp of the newest view fused into the cloud: the cloud's and mesh's
+  // header stamp (data time, not the clock).
+  ros::Time newest_stamp;
   double last_fuse_seconds = 0;
 
   std::string Topic() const { return nh.resolveName("depth_view"); }
@@ -172,7 +182,8 @@ struct FusionNode::Impl {
 
   // Decodes and validates a view; adds it to the reorder buffer.
   void Accept(const wild_mvs::DepthView& msg) {
-    if (msg.camera_pose.header.frame_id != options.world_frame) {
+    if (StripLeadingSlash(msg.camera_pose.header.frame_id) !=
+        options.world_frame) {
       Drop("camera_pose frame '" + msg.camera_pose.header.frame_id +
            "' is not the world frame '" + options.world_frame + "'");
       return;
@@ -231,6 +242,7 @@ struct FusionNode::Impl {
     held_order.clear();
     held_bytes = 0;
     view_of_stamp.clear();
+    newest_stamp = ros::Time();
     last_fused_id = -1;
     ++cloud_version;
   }
@@ -276,6 +288,7 @@ struct FusionNode::Impl {
       }
     }
     const int v = next_view++;
+    const ros::Time stamp = item.stamp;
     view_of_stamp[key] = v;
     item.map.view = v;
     item.map.neighbors.clear();
@@ -291,6 +304,7 @@ struct FusionNode::Impl {
       fusion->AddView(v);
       ++fused;
       ++cloud_version;
+      newest_stamp = std::max(newest_stamp, stamp);
     } catch (const std::exception& e) {
       Drop("fusion rejected the view", e.what());
     }
@@ -319,16 +333,18 @@ struct FusionNode::Impl {
 
   void PublishCloud(bool force) {
     PointCloud cloud;
+    ros::Time stamp;
     {
       std::lock_guard<std::mutex> lock(fusion_mutex);
       FuseReadyLocked();
       if (!force && published_version == cloud_version) return;
       published_version = cloud_version;
       cloud = fusion->Cloud();
+      stamp = newest_stamp;
     }
     sensor_msgs::PointCloud2 msg =
         CloudToMsg(cloud, static_cast<size_t>(options.max_published_points));
-    msg.header.stamp = ros::Time::now();
+    msg.header.stamp = stamp;
     msg.header.frame_id = options.world_frame;
     cloud_pub.publish(msg);
   }
@@ -336,11 +352,13 @@ struct FusionNode::Impl {
   void PublishMesh() {
 #ifdef WILD_MVS_HAVE_MESHING
     PointCloud cloud;
+    ros::Time stamp;
     {
       std::lock_guard<std::mutex> lock(fusion_mutex);
       if (meshed_version == cloud_version) return;
       meshed_version = cloud_version;
       cloud = fusion->Cloud();
+      stamp = newest_stamp;
     }
     if (cloud.size() < 100 || !cloud.has_normal()) return;
     try {
@@ -348,7 +366,7 @@ struct FusionNode::Impl {
       mo.depth = 8;
       Mesh mesh = MeshPointCloud(cloud, mo);
       visualization_msgs::Marker m = MeshToMarker(mesh);
-      m.header.stamp = ros::Time::now();
+      m.header.stamp = stamp;
       m.header.frame_id = options.world_frame;
       m.ns = "wild_mvs";
       mesh_pub.publish(m);
@@ -455,6 +473,14 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     ROS_WARN(
         "%s: unknown parameter '%s' (ignored; see config/fusion_node.yaml)",
         pnh.getNamespace().c_str(), n.c_str());
+  if (StripLeadingSlash(m.options.world_frame) != m.options.world_frame) {
+    // tf2 frame ids have no leading '/'.
+    const std::string w = StripLeadingSlash(m.options.world_frame);
+    ROS_WARN("%s: world_frame '%s' starts with '/': using '%s'",
+             pnh.getNamespace().c_str(), m.options.world_frame.c_str(),
+             w.c_str());
+    m.options.world_frame = w;
+  }
   m.drops.set_throttle(m.options.error_throttle);
   const FusionNodeOptions& o = m.options;
   if (o.spill_dir.empty()) {
@@ -475,20 +501,20 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.save_srv = m.pnh.advertiseService("save", &Impl::OnSave, &m);
   m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
   m.sub = m.nh.subscribe("depth_view", o.input_queue_size, &Impl::OnView, &m);
-  m.publish_timer =
-      m.nh.createTimer(ros::Duration(o.publish_period),
-                       [&m](const ros::TimerEvent&) { m.PublishCloud(false); });
+  m.publish_timer = m.nh.createSteadyTimer(
+      ros::WallDuration(o.publish_period),
+      [&m](const ros::SteadyTimerEvent&) { m.PublishCloud(false); });
   if (o.mesh_period > 0)
-    m.mesh_timer =
-        m.nh.createTimer(ros::Duration(o.mesh_period),
-                         [&m](const ros::TimerEvent&) { m.PublishMesh(); });
+    m.mesh_timer = m.nh.createSteadyTimer(
+        ros::WallDuration(o.mesh_period),
+        [&m](const ros::SteadyTimerEvent&) { m.PublishMesh(); });
   m.updater = std::make_unique<diagnostic_updater::Updater>(
       m.nh, m.pnh, m.pnh.getNamespace());
   m.updater->setHardwareID("wild_mvs_fusion");
   m.updater->add("fusion_node", &m, &Impl::Diagnose);
-  m.diag_timer = m.nh.createTimer(
-      ros::Duration(o.diagnostics_period),
-      [&m](const ros::TimerEvent&) { m.updater->force_update(); });
+  m.diag_timer = m.nh.createSteadyTimer(
+      ros::WallDuration(o.diagnostics_period),
+      [&m](const ros::SteadyTimerEvent&) { m.updater->force_update(); });
   m.worker = std::thread([&m] { m.Work(); });
 }
 

@@ -117,7 +117,11 @@ std::vector<std::string> BindDepth(Binder& b, DepthNodeOptions* o) {
   b.Bind("pose_source", &o->pose_source);
   b.Bind("tf_timeout", &o->tf_timeout);
   b.Bind("pose_sync_tolerance", &o->pose_sync_tolerance);
+  b.Bind("camera_frame", &o->camera_frame);
   b.Bind("image_transport", &o->image_transport);
+  b.Bind("camera_info_latest", &o->camera_info_latest);
+  b.Bind("rectified", &o->rectified);
+  b.Bind("depth_encoding", &o->depth_encoding);
   b.Bind("sparse_source", &o->sparse_source);
   b.Bind("input_queue_size", &o->input_queue_size);
   b.Bind("diagnostics_period", &o->diagnostics_period);
@@ -255,9 +259,13 @@ void DepthNodeOptions::Check() const {
   Require(!world_frame.empty(), "world_frame must not be empty");
   Require(pose_source == "tf" || pose_source == "topic", "pose_source = '",
           pose_source, "' must be 'tf' or 'topic'");
-  Require(image_transport == "raw" || image_transport == "compressed",
+  Require(!image_transport.empty() &&
+              image_transport.find_first_of("/ ") == std::string::npos,
           "image_transport = '", image_transport,
-          "' must be 'raw' or 'compressed'");
+          "' must name an image_transport plugin (raw, compressed, ...)");
+  Require(depth_encoding == "32FC1" || depth_encoding == "16UC1",
+          "depth_encoding = '", depth_encoding,
+          "' must be '32FC1' (metres) or '16UC1' (millimetres)");
   Require(sparse_source == "tracker" || sparse_source == "topic" ||
               sparse_source == "none",
           "sparse_source = '", sparse_source,

@@ -82,6 +82,7 @@ void StreamReconstructor::ClearLocked() {
   ++generation_;
   next_id_ = 0;  // ids restart in the new session
   session_ = -1;
+  session_ns_ = 0;
   have_last_center_ = false;
   if (options_.use_tracker)
     tracker_ = std::make_unique<SparseTracker>(options_.tracker, nullptr);
@@ -98,6 +99,18 @@ void StreamReconstructor::Reset() {
 StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     double stamp, const std::string& frame_id, const Camera& camera,
     const cv::Mat& image) {
+  Require(std::isfinite(stamp) && stamp >= 0, "frame '", frame_id, "': stamp ",
+          stamp, " is not a finite time >= 0");
+  return AddFrame(static_cast<uint64_t>(std::llround(stamp * 1e9)), frame_id,
+                  camera, image);
+}
+
+StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
+    uint64_t stamp_ns, const std::string& frame_id, const Camera& camera,
+    const cv::Mat& image) {
+  // Seconds for the stream's timing rules; the exact stamp for the outputs.
+  const double stamp = static_cast<double>(stamp_ns / 1000000000ull) +
+                       static_cast<double>(stamp_ns % 1000000000ull) * 1e-9;
   camera.Validate("frame '" + frame_id + "'");
   Require(image.type() == CV_32FC3, "frame '", frame_id,
           "': image must be CV_32FC3");
@@ -131,13 +144,17 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     last_stamp_ = stamp;
     last_center_ = center;
     have_last_center_ = true;
-    if (session_ < 0) session_ = stamp;
+    if (session_ < 0) {
+      session_ = stamp;
+      session_ns_ = stamp_ns;
+    }
     if (!store_.IsNewKeyframe(camera, options_.keyframes))
       return FrameStatus::kNotKeyframe;
 
     kf = std::make_shared<Keyframe>();
     kf->id = next_id_++;
     kf->stamp = stamp;
+    kf->stamp_ns = stamp_ns;
     kf->frame_id = frame_id;
     kf->camera = camera;
     kf->image = image;
@@ -310,6 +327,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   KeyframePtr kf;
   int ref = -1;
   double session = 0;
+  uint64_t session_ns = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (stopping_ || generation != generation_) {
@@ -328,11 +346,14 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     for (size_t i = 0; i < snap.keyframes.size(); ++i)
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
     session = session_;
+    session_ns = session_ns_;
   }
   StreamResult result;
   result.keyframe_id = id;
   result.session = session;
+  result.session_ns = session_ns;
   result.stamp = kf->stamp;
+  result.stamp_ns = kf->stamp_ns;
   result.frame_id = kf->frame_id;
   result.image = kf->image;
   std::string error;
@@ -350,6 +371,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       if (n < 0 || n >= static_cast<int>(kfs.size())) continue;
       result.neighbor_ids.push_back(kfs[n]->id);
       result.neighbor_stamps.push_back(kfs[n]->stamp);
+      result.neighbor_stamps_ns.push_back(kfs[n]->stamp_ns);
       result.depth.neighbors.push_back(static_cast<int>(kfs[n]->id));
     }
     for (double s : report.neighbor_scores) score += s;

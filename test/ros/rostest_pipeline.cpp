@@ -54,7 +54,8 @@ TEST(Pipeline, BagThroughDepthAndFusionNodes) {
     return static_cast<int>(std::lround((t.toSec() - bo.start_time) * kRate));
   };
   ros::Subscriber s1 = nh.subscribe<sensor_msgs::Image>(
-      "/depth_node/depth", 20, [&](const sensor_msgs::ImageConstPtr& m) {
+      "/depth_node/depth/image_rect", 20,
+      [&](const sensor_msgs::ImageConstPtr& m) {
         std::lock_guard<std::mutex> lock(mutex);
         depth[index_of(m->header.stamp)] = m;
       });

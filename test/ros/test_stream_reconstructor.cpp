@@ -109,6 +109,46 @@ TEST(StreamReconstructor, DepthMapsMatchGroundTruth) {
   EXPECT_EQ(ids.size(), 6u);
 }
 
+// Real-world stamps (epoch seconds with microseconds, 30 Hz) come back bit
+// for bit: a double cannot hold 1305031102.175304 exactly, so stamps must
+// never pass through one on their way to the outputs.
+TEST(StreamReconstructor, EpochStampsPassThroughExactly) {
+  const SyntheticScene& s = Scene6();
+  Collector c;
+  StreamReconstructor stream(FastOptions(), c.OnResult(), c.OnError());
+  const uint64_t t0 = 1305031102175304000ull;  // TUM RGB-D fr1/xyz
+  std::set<uint64_t> stamps;
+  std::vector<StreamReconstructor::StampedPoint> points = StampedPoints(s);
+  auto stamp_of = [&](size_t i) -> uint64_t {
+    return t0 + i * 33333000ull + i * 17;
+  };
+  for (auto& p : points)
+    for (auto& o : p.observations)
+      o.stamp =
+          static_cast<double>(stamp_of(static_cast<size_t>(o.stamp))) * 1e-9;
+  stream.SetSparsePoints(points);
+  for (size_t i = 0; i < s.scene.views.size(); ++i) {
+    stamps.insert(stamp_of(i));
+    stream.AddFrame(stamp_of(i), "camera", s.scene.views[i].camera,
+                    s.images[i]);
+  }
+  for (int k = 0; k < 50; ++k) {
+    stream.WaitIdle();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    stream.Tick();
+    if (stream.Stats().pending == 0 && k > 8) break;
+  }
+  stream.WaitIdle();
+  ASSERT_EQ(c.results.size(), 6u);
+  for (const StreamResult& r : c.results) {
+    EXPECT_EQ(r.stamp_ns, stamp_of(r.keyframe_id));
+    EXPECT_EQ(r.session_ns, t0);
+    ASSERT_EQ(r.neighbor_stamps_ns.size(), r.neighbor_ids.size());
+    for (size_t n = 0; n < r.neighbor_ids.size(); ++n)
+      EXPECT_EQ(r.neighbor_stamps_ns[n], stamp_of(r.neighbor_ids[n]));
+  }
+}
+
 TEST(StreamReconstructor, WorkersSplitKeyframesByIndex) {
   const SyntheticScene& s = Scene6();
   StreamOptions o = FastOptions();

@@ -2,16 +2,27 @@
 // per-keyframe depth / confidence / normals / points and DepthView out.
 //
 // Topics (relative, meant for remapping):
-//   in:  image (sensor_msgs/Image, or image/compressed with
-//        ~image_transport:=compressed), camera_info, pose
-//        (geometry_msgs/PoseStamped, ~pose_source:=topic), sparse_points
-//        (wild_mvs/SparsePoints, ~sparse_source:=topic)
-//   out (private, ~name): depth, confidence, normals (sensor_msgs/Image),
-//        depth_camera_info, points (sensor_msgs/PointCloud2, world frame)
-//        -- only built when subscribed --, depth_view (wild_mvs/DepthView,
-//        always); diagnostics on /diagnostics.
-// Pose by default from tf2: ~world_frame <- the image's frame_id at the image
-// stamp, waiting up to ~tf_timeout. Parameters: config/depth_node.yaml.
+//   in:  image (through image_transport: ~image_transport names the plugin;
+//        "compressed" is decoded here when its plugin is not installed),
+//        camera_info (beside the image, image_transport's CameraSubscriber
+//        convention, unless `camera_info` itself is remapped; paired with
+//        the image by exact stamp, or the latest with ~camera_info_latest),
+//        pose (geometry_msgs/PoseStamped, ~pose_source:=topic),
+//        sparse_points (wild_mvs/SparsePoints, ~sparse_source:=topic)
+//   out (private, ~name), each with the source image's header (stamp bit
+//        for bit, frame = the camera optical frame):
+//        depth/image_rect + depth/camera_info (image_transport
+//        CameraPublisher; 32FC1 metres, NaN unknown, REP 118, or 16UC1 mm
+//        with ~depth_encoding), confidence/image + confidence/camera_info
+//        (32FC1 in [0, 1]), normals/image (32FC3, camera frame), points
+//        (sensor_msgs/PointCloud2, world frame) -- only built when
+//        subscribed --, depth_view (wild_mvs/DepthView, always);
+//        diagnostics on /diagnostics.
+// Pose by default from tf2: ~world_frame <- ~camera_frame (default: the
+// image's frame_id) at the image stamp, waiting up to ~tf_timeout of wall
+// time (never ROS time: /clock may stand still). Leading '/' of incoming
+// frame ids is stripped (one warning per id). Periodic work runs on steady
+// timers. Parameters: config/depth_node.yaml.
 //
 // Callbacks only queue messages (bounded; the oldest is dropped and counted
 // when full). A front-end thread converts, looks up the pose and feeds the

@@ -33,6 +33,7 @@ namespace ros1 {
 struct Keyframe {
   uint32_t id = 0;
   double stamp = 0;           // seconds (ROS time of the image)
+  uint64_t stamp_ns = 0;      // the image's exact stamp (ns), passed through
   std::string frame_id;       // camera optical frame of the image
   Camera camera;              // of `image` (undistorted, maybe downscaled)
   cv::Mat image;              // CV_32FC3 linear RGB

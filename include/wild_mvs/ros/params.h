@@ -68,9 +68,26 @@ struct DepthNodeOptions {
   std::string pose_source = "tf";
   double tf_timeout = 0.2;            // s to wait for tf / a pose
   double pose_sync_tolerance = 0.01;  // s, pose topic stamp match
-  // "raw" (sensor_msgs/Image on `image`) or "compressed"
-  // (sensor_msgs/CompressedImage on `image/compressed`, decoded here).
+  // Camera optical frame of the images; "" = the image header's frame_id.
+  // Set it when a driver stamps images with another frame (e.g. a body or
+  // link frame); tf must give world_frame <- camera_frame.
+  std::string camera_frame;
+  // image_transport plugin for `image`: "raw", or any installed plugin
+  // ("theora", ...). "compressed" (`image/compressed`) is decoded here with
+  // cv::imdecode when the compressed plugin is not installed.
   std::string image_transport = "raw";
+  // camera_info is paired with the image of the same stamp (image_transport
+  // CameraSubscriber convention: `camera_info` beside the image topic).
+  // true: use the latest camera_info instead, for drivers that publish it
+  // once or at another rate.
+  bool camera_info_latest = false;
+  // The images are rectified: the camera is P's, D is ignored (never
+  // undistorted twice). Also on when the image topic ends in image_rect or
+  // image_rect_color.
+  bool rectified = false;
+  // ~depth/image_rect encoding: "32FC1" (metres, NaN = unknown, REP 118) or
+  // "16UC1" (millimetres, 0 = unknown).
+  std::string depth_encoding = "32FC1";
   // "tracker": sparse tracks built online; "topic": wild_mvs/SparsePoints on
   // `sparse_points`.
   // "none": no sparse points (frustum-overlap neighbours, sweep seeds).

@@ -84,14 +84,19 @@ struct StreamResult {
   // agree on sessions and ids; a restarted node starts a new session.
   double session = 0;
   double stamp = 0;
+  // The same stamps, exact (ns since the epoch of the image header's
+  // ros::Time): outputs carry these bit for bit, never the doubles.
+  uint64_t session_ns = 0;
+  uint64_t stamp_ns = 0;
   std::string frame_id;
-  int revision = 0;                     // 0 first time, then 1, 2 ...
-  std::vector<uint32_t> neighbor_ids;   // keyframe ids matched against
-  std::vector<double> neighbor_stamps;  // and their stamps
-  cv::Mat image;                        // the keyframe image (linear RGB)
-  DepthMap depth;                       // camera = keyframe camera at the
-                                        // depth map's resolution
-  double seconds = 0;                   // wall time of the reconstruction
+  int revision = 0;                          // 0 first time, then 1, 2 ...
+  std::vector<uint32_t> neighbor_ids;        // keyframe ids matched against
+  std::vector<double> neighbor_stamps;       // and their stamps
+  std::vector<uint64_t> neighbor_stamps_ns;  // exact (ns)
+  cv::Mat image;                             // the keyframe image (linear RGB)
+  DepthMap depth;                            // camera = keyframe camera at the
+                                             // depth map's resolution
+  double seconds = 0;                        // wall time of the reconstruction
 };
 
 struct StreamStats {
@@ -138,6 +143,11 @@ class StreamReconstructor {
   // stamp_reset_threshold s before the previous one resets the stream (bag
   // loop, restarted clock); other stamps not after the previous one are
   // kOutOfOrder. Throws Error on an invalid camera or image.
+  // `stamp_ns` is the image's exact stamp (ros::Time::toNSec()); the
+  // results carry it unchanged.
+  FrameStatus AddFrame(uint64_t stamp_ns, const std::string& frame_id,
+                       const Camera& camera, const cv::Mat& image);
+  // The same with a stamp in seconds (rounded to ns; tests and tools).
   FrameStatus AddFrame(double stamp, const std::string& frame_id,
                        const Camera& camera, const cv::Mat& image);
   // Replaces the sparse points (use_tracker = false). Observations refer to
@@ -199,6 +209,7 @@ class StreamReconstructor {
   double last_keyframe_wall_ = 0;  // steady clock, s
   double last_stamp_ = -1;
   double session_ = -1;  // see StreamResult::session
+  uint64_t session_ns_ = 0;
   bool have_last_center_ = false;
   Eigen::Vector3d last_center_{0, 0, 0};
   StreamStats stats_;
