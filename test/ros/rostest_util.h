@@ -122,8 +122,12 @@ inline double PeakRssMb(int pid) {
 inline std::thread PlayBag(const std::string& bag, double rate,
                            const std::string& extra = "") {
   // `extra` after the bag: --topics takes every argument that follows it.
-  const std::string cmd = "rosbag play --quiet -r " + std::to_string(rate) +
-                          " '" + bag + "' " + extra + " >/dev/null 2>&1";
+  // -d: a pause after each advertise so that every subscriber (image AND
+  // camera_info, which are paired by exact stamp) is connected before the
+  // first message, as reconstruct_bag.launch does.
+  const std::string cmd = "rosbag play --quiet -d 0.3 -r " +
+                          std::to_string(rate) + " '" + bag + "' " + extra +
+                          " >/dev/null 2>&1";
   return std::thread([cmd] {
     if (std::system(cmd.c_str()) != 0) ROS_ERROR("failed: %s", cmd.c_str());
   });
