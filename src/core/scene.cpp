@@ -28,8 +28,9 @@ std::vector<std::vector<int>> Scene::PointsPerView() const {
   std::vector<std::vector<int>> out(views.size());
   for (size_t p = 0; p < points.size(); ++p)
     for (const Observation& o : points[p].track)
-      if (o.view >= 0 && o.view < static_cast<int>(views.size()))
-        out[o.view].push_back(static_cast<int>(p));
+      if (o.view >= 0 && o.view < static_cast<int>(views.size()) &&
+          (out[o.view].empty() || out[o.view].back() != static_cast<int>(p)))
+        out[o.view].push_back(static_cast<int>(p));  // once per view
   return out;
 }
 
