@@ -96,8 +96,8 @@ TEST(Undistorter, NoDistortionIsPassThrough) {
 
 // Renders the distorted image of Pattern for `info` (each distorted pixel
 // takes the pattern's value at its undistorted position, found with
-// cv::undistortPointsIter and checked with cv::projectPoints), undistorts it
-// and compares with Pattern away from the border.
+// iterative cv::undistortPoints and checked with cv::projectPoints), undistorts
+// it and compares with Pattern away from the border.
 void CheckRecovers(const sensor_msgs::CameraInfo& info) {
   Camera cam;
   Distortion d;
@@ -109,7 +109,7 @@ void CheckRecovers(const sensor_msgs::CameraInfo& info) {
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) distorted.emplace_back(x, y);
   std::vector<cv::Point2f> undistorted;
-  cv::undistortPointsIter(
+  cv::undistortPoints(
       distorted, undistorted, K, D, cv::noArray(), K,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100,
                        1e-10));
