@@ -47,10 +47,11 @@ namespace ros1 {
 //
 // Binning and ROI. info.width/height, K and P describe the full-resolution
 // sensor; the image actually delivered is the ROI (x_offset, y_offset,
-// width, height; width or height 0 = the full sensor in that direction) of
-// it, then binned by binning_x/binning_y (0 or 1 = none). So the camera
-// returned describes the delivered image:
-//   width  = (roi.width  ? roi.width  : info.width)  / bx   (integer division)
+// width, height; a width or height of 0 = from the offset to the sensor's
+// edge, so the all-zero roi = the full sensor) of it, then binned by
+// binning_x/binning_y (0 or 1 = none). So the camera returned describes the
+// delivered image:
+//   width  = (roi.width ? roi.width : info.width - x_offset) / bx  (floor)
 //   fx'    = fx / bx
 //   cx'    = (cx_core - x_offset) / bx          (core pixel centres)
 //          = (K[2] + 0.5 - x_offset) / bx       (from ROS K)
