@@ -69,50 +69,98 @@ sensor_msgs::Image MatToMsg(const cv::Mat& m, const std::string& encoding) {
 }  // namespace
 
 void CameraFromCameraInfo(const sensor_msgs::CameraInfo& info, Camera* camera,
-                          Distortion* distortion) {
+                          Distortion* distortion, bool rectified) {
   const auto& K = info.K;
+  const auto& P = info.P;
   Require(info.width > 0 && info.height > 0, "camera_info: image size is ",
           info.width, "x", info.height);
   // Larger sizes would also overflow Camera's int width/height.
   Require(info.width <= kMaxMsgImageSide && info.height <= kMaxMsgImageSide,
           "camera_info: image size ", info.width, "x", info.height,
           " is too large (at most ", kMaxMsgImageSide, " per side)");
-  for (double v : K)
-    Require(Finite(v), "camera_info: K has a non-finite value");
-  Require(K[0] > 0 && K[4] > 0,
-          "camera_info: zero or negative focal length (fx=", K[0], " fy=", K[4],
-          ")");
-  Require(K[1] == 0, "camera_info: skew K[1] = ", K[1], " is not supported");
-  const double cx = K[2] + 0.5, cy = K[5] + 0.5;  // ROS -> core pixel centres
-  Require(cx > -double(info.width) && cx < 2.0 * info.width &&
-              cy > -double(info.height) && cy < 2.0 * info.height,
-          "camera_info: principal point (", K[2], ", ", K[5],
-          ") is far outside the ", info.width, "x", info.height, " image");
-  camera->fx = K[0];
-  camera->fy = K[4];
+  double fx, fy, cx_ros, cy_ros;
+  if (rectified) {
+    for (double v : P)
+      Require(Finite(v), "camera_info: P has a non-finite value");
+    Require(std::any_of(P.begin(), P.end(), [](double v) { return v != 0; }),
+            "camera_info: P is all zero (uncalibrated camera) in rectified "
+            "mode");
+    Require(P[0] > 0 && P[5] > 0,
+            "camera_info: zero or negative focal length in P (fx=", P[0],
+            " fy=", P[5], ")");
+    Require(P[1] == 0, "camera_info: skew P[1] = ", P[1], " is not supported");
+    Require(P[10] == 1, "camera_info: P[10] = ", P[10], " (expected 1)");
+    // P[3], P[7] (stereo baseline) are ignored: the pose comes from tf.
+    fx = P[0];
+    fy = P[5];
+    cx_ros = P[2];
+    cy_ros = P[6];
+  } else {
+    for (double v : K)
+      Require(Finite(v), "camera_info: K has a non-finite value");
+    Require(K[0] > 0 && K[4] > 0,
+            "camera_info: zero or negative focal length (fx=", K[0],
+            " fy=", K[4], ")");
+    Require(K[1] == 0, "camera_info: skew K[1] = ", K[1], " is not supported");
+    fx = K[0];
+    fy = K[4];
+    cx_ros = K[2];
+    cy_ros = K[5];
+  }
+  // ROI then binning (header). 0 means none / full sensor.
+  const auto& roi = info.roi;
+  const uint32_t bx = info.binning_x > 1 ? info.binning_x : 1;
+  const uint32_t by = info.binning_y > 1 ? info.binning_y : 1;
+  const uint64_t roi_w =
+      roi.width ? roi.width : info.width - std::min(info.width, roi.x_offset);
+  const uint64_t roi_h =
+      roi.height ? roi.height
+                 : info.height - std::min(info.height, roi.y_offset);
+  Require(uint64_t(roi.x_offset) + roi_w <= info.width &&
+              uint64_t(roi.y_offset) + roi_h <= info.height && roi_w > 0 &&
+              roi_h > 0,
+          "camera_info: roi (x_offset ", roi.x_offset, ", y_offset ",
+          roi.y_offset, ", width ", roi.width, ", height ", roi.height,
+          ") is not inside the ", info.width, "x", info.height, " sensor");
+  Require(bx <= roi_w && by <= roi_h, "camera_info: binning ", info.binning_x,
+          "x", info.binning_y, " is larger than the ", roi_w, "x", roi_h,
+          " roi");
+  const int width = static_cast<int>(roi_w / bx);
+  const int height = static_cast<int>(roi_h / by);
+  // ROS -> core pixel centres (+0.5), then ROI and binning.
+  const double cx = (cx_ros + 0.5 - roi.x_offset) / bx;
+  const double cy = (cy_ros + 0.5 - roi.y_offset) / by;
+  Require(cx > -double(width) && cx < 2.0 * width && cy > -double(height) &&
+              cy < 2.0 * height,
+          "camera_info: principal point (", cx_ros, ", ", cy_ros,
+          ") is far outside the ", width, "x", height, " image");
+  camera->fx = fx / bx;
+  camera->fy = fy / by;
   camera->cx = cx;
   camera->cy = cy;
-  camera->width = static_cast<int>(info.width);
-  camera->height = static_cast<int>(info.height);
+  camera->width = width;
+  camera->height = height;
   Distortion d;
-  const auto& D = info.D;
-  for (double v : D)
-    Require(Finite(v), "camera_info: D has a non-finite value");
-  bool any = std::any_of(D.begin(), D.end(), [](double v) { return v != 0; });
-  if (any) {
-    Require(info.distortion_model == "plumb_bob" ||
-                info.distortion_model == "rational_polynomial",
-            "camera_info: distortion model '", info.distortion_model,
-            "' is not supported (plumb_bob, rational_polynomial)");
-    for (size_t i = 5; i < D.size(); ++i)
-      Require(D[i] == 0, "camera_info: rational_polynomial coefficient D[", i,
-              "] = ", D[i], " is not supported");
-    d.model = Distortion::Model::kOpenCV;
-    d.k1 = D.size() > 0 ? D[0] : 0;
-    d.k2 = D.size() > 1 ? D[1] : 0;
-    d.p1 = D.size() > 2 ? D[2] : 0;
-    d.p2 = D.size() > 3 ? D[3] : 0;
-    d.k3 = D.size() > 4 ? D[4] : 0;
+  if (!rectified) {
+    const auto& D = info.D;
+    for (double v : D)
+      Require(Finite(v), "camera_info: D has a non-finite value");
+    bool any = std::any_of(D.begin(), D.end(), [](double v) { return v != 0; });
+    if (any) {
+      Require(info.distortion_model == "plumb_bob" ||
+                  info.distortion_model == "rational_polynomial",
+              "camera_info: distortion model '", info.distortion_model,
+              "' is not supported (plumb_bob, rational_polynomial)");
+      for (size_t i = 5; i < D.size(); ++i)
+        Require(D[i] == 0, "camera_info: rational_polynomial coefficient D[", i,
+                "] = ", D[i], " is not supported");
+      d.model = Distortion::Model::kOpenCV;
+      d.k1 = D.size() > 0 ? D[0] : 0;
+      d.k2 = D.size() > 1 ? D[1] : 0;
+      d.p1 = D.size() > 2 ? D[2] : 0;
+      d.p2 = D.size() > 3 ? D[3] : 0;
+      d.k3 = D.size() > 4 ? D[4] : 0;
+    }
   }
   if (distortion) *distortion = d;
 }
@@ -189,12 +237,36 @@ cv::Mat ImageToLinearRgb(const sensor_msgs::Image& msg, bool linearize) {
     m = WrapImage(msg, CV_8UC4, what);
   } else if (e == enc::TYPE_32FC1) {
     m = WrapImage(msg, CV_32FC1, what);
+  } else if (e == enc::BAYER_RGGB8 || e == enc::BAYER_BGGR8 ||
+             e == enc::BAYER_GBRG8 || e == enc::BAYER_GRBG8 ||
+             e == enc::BAYER_RGGB16 || e == enc::BAYER_BGGR16 ||
+             e == enc::BAYER_GBRG16 || e == enc::BAYER_GRBG16) {
+    const bool is16 = enc::bitDepth(e) == 16;
+    cv::Mat raw = WrapImage(msg, is16 ? CV_16UC1 : CV_8UC1, what);
+    Require(raw.cols >= 2 && raw.rows >= 2, what,
+            ": a Bayer image needs at least 2x2 pixels");
+    // OpenCV names a Bayer pattern by the 2x2 block starting at pixel (1, 1)
+    // (its second row and column), ROS by the one at (0, 0): image_proc's
+    // mapping (rggb -> BayerBG, bggr -> BayerRG, gbrg -> BayerGR, grbg ->
+    // BayerGB). Checked by the Conversions.BayerDemosaic test.
+    int code;
+    if (e == enc::BAYER_RGGB8 || e == enc::BAYER_RGGB16) {
+      code = cv::COLOR_BayerBG2BGR;
+    } else if (e == enc::BAYER_BGGR8 || e == enc::BAYER_BGGR16) {
+      code = cv::COLOR_BayerRG2BGR;
+    } else if (e == enc::BAYER_GBRG8 || e == enc::BAYER_GBRG16) {
+      code = cv::COLOR_BayerGR2BGR;
+    } else {
+      code = cv::COLOR_BayerGB2BGR;
+    }
+    cv::cvtColor(raw, m, code);  // BGR, a new buffer
   } else if (e == enc::TYPE_32FC3) {
     m = WrapImage(msg, CV_32FC3, what);
   } else {
     throw Error(Msg("image: unsupported encoding '", e,
                     "' (expected mono8, mono16, rgb8, bgr8, rgba8, bgra8, "
-                    "rgb16, bgr16, 32FC1 or 32FC3)"));
+                    "rgb16, bgr16, 32FC1, 32FC3, bayer_rggb8, bayer_bggr8, "
+                    "bayer_gbrg8, bayer_grbg8 or their 16-bit variants)"));
   }
   // ToLinearRgb expects OpenCV's BGR(A) order.
   cv::Mat bgr;
@@ -246,6 +318,27 @@ sensor_msgs::Image DepthToMsg(const cv::Mat& depth) {
     if (!(v > 0) || !std::isfinite(v)) v = kNaN;
   });
   return MatToMsg(d, enc::TYPE_32FC1);
+}
+
+sensor_msgs::Image DepthToMsg16(const cv::Mat& depth) {
+  Require(depth.type() == CV_32FC1, "DepthToMsg16: depth must be CV_32FC1");
+  cv::Mat mm(depth.size(), CV_16UC1);
+  for (int r = 0; r < depth.rows; ++r) {
+    const float* src = depth.ptr<float>(r);
+    uint16_t* dst = mm.ptr<uint16_t>(r);
+    for (int c = 0; c < depth.cols; ++c) {
+      const float v = src[c];
+      const double m =
+          std::isfinite(v) && v > 0 ? std::round(double(v) * 1000) : 0.0;
+      dst[c] = m > 0 && m <= 65535 ? static_cast<uint16_t>(m) : 0;
+    }
+  }
+  return MatToMsg(mm, enc::TYPE_16UC1);
+}
+
+std::string StripLeadingSlash(const std::string& frame_id) {
+  const size_t i = frame_id.find_first_not_of('/');
+  return i == std::string::npos ? std::string() : frame_id.substr(i);
 }
 
 sensor_msgs::Image ConfidenceToMsg(const cv::Mat& confidence) {

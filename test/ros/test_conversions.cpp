@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/image.h"
@@ -345,6 +347,239 @@ TEST(Conversions, DepthMapToCloudIsInWorldFrame) {
   // Every point projects back to depth 2.
   for (const auto& p : cloud.xyz)
     EXPECT_NEAR(dm.camera.Depth(p.cast<double>()), 2.0, 1e-5);
+}
+
+// Every plain encoding the brief lists: one known pixel, read without
+// linearisation, comes out as the core's RGB.
+TEST(Conversions, AllPlainEncodings) {
+  namespace enc = sensor_msgs::image_encodings;
+  const float r = 200 / 255.f, g = 100 / 255.f, b = 50 / 255.f;
+  struct Case {
+    std::string encoding;
+    std::vector<uint8_t> pixel;
+  };
+  const std::vector<Case> cases = {{enc::RGB8, {200, 100, 50}},
+                                   {enc::BGR8, {50, 100, 200}},
+                                   {enc::RGBA8, {200, 100, 50, 255}},
+                                   {enc::BGRA8, {50, 100, 200, 255}}};
+  for (const Case& c : cases) {
+    auto img = MakeImage(3, 2, c.encoding, int(c.pixel.size()));
+    std::memcpy(&img.data[img.step + c.pixel.size()], c.pixel.data(),
+                c.pixel.size());  // pixel (1, 1)
+    cv::Mat out = ImageToLinearRgb(img, false);
+    ASSERT_EQ(out.type(), CV_32FC3) << c.encoding;
+    ASSERT_EQ(out.size(), cv::Size(3, 2)) << c.encoding;
+    const cv::Vec3f v = out.at<cv::Vec3f>(1, 1);
+    EXPECT_NEAR(v[0], r, 1e-6) << c.encoding;
+    EXPECT_NEAR(v[1], g, 1e-6) << c.encoding;
+    EXPECT_NEAR(v[2], b, 1e-6) << c.encoding;
+    EXPECT_EQ(out.at<cv::Vec3f>(0, 0), cv::Vec3f(0, 0, 0)) << c.encoding;
+  }
+  auto mono8 = MakeImage(3, 2, enc::MONO8, 1);
+  mono8.data[4] = 100;
+  cv::Mat out = ImageToLinearRgb(mono8, false);
+  EXPECT_NEAR(out.at<cv::Vec3f>(1, 1)[0], g, 1e-6);
+  EXPECT_NEAR(out.at<cv::Vec3f>(1, 1)[2], g, 1e-6);
+  auto mono16 = MakeImage(3, 2, enc::MONO16, 2);
+  const uint16_t v16 = 30000;
+  std::memcpy(&mono16.data[mono16.step + 2], &v16, 2);
+  out = ImageToLinearRgb(mono16, false);
+  EXPECT_NEAR(out.at<cv::Vec3f>(1, 1)[1], 30000 / 65535.f, 1e-5);
+}
+
+// A flat colour mosaiced in each ROS Bayer pattern (pattern letters name
+// pixels (0,0) (0,1) (1,0) (1,1)) demosaics back to that colour: catches
+// OpenCV's shifted COLOR_Bayer* names.
+TEST(Conversions, BayerDemosaic) {
+  namespace enc = sensor_msgs::image_encodings;
+  const int w = 16, h = 12;
+  const double rgb[3] = {200, 100, 30};  // fraction of full scale: /255
+  for (const std::string pattern : {"rggb", "bggr", "gbrg", "grbg"}) {
+    for (int bits : {8, 16}) {
+      const std::string e = "bayer_" + pattern + std::to_string(bits);
+      const int bpp = bits / 8;
+      auto img = MakeImage(w, h, e, bpp);
+      const double scale = bits == 8 ? 1.0 : 257.0;  // 255 -> 65535
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const char ch = pattern[2 * (y % 2) + (x % 2)];
+          const int c = ch == 'r' ? 0 : ch == 'g' ? 1 : 2;
+          const double v = rgb[c] * scale;
+          uint8_t* p = &img.data[y * img.step + x * bpp];
+          if (bits == 8) {
+            *p = static_cast<uint8_t>(v);
+          } else {
+            const uint16_t v16 = static_cast<uint16_t>(v);
+            std::memcpy(p, &v16, 2);
+          }
+        }
+      }
+      cv::Mat out = ImageToLinearRgb(img, false);
+      ASSERT_EQ(out.type(), CV_32FC3) << e;
+      ASSERT_EQ(out.size(), cv::Size(w, h)) << e;
+      for (int y = 2; y < h - 2; ++y)
+        for (int x = 2; x < w - 2; ++x)
+          for (int c = 0; c < 3; ++c)
+            ASSERT_NEAR(out.at<cv::Vec3f>(y, x)[c], rgb[c] / 255.0, 2e-3)
+                << e << " pixel (" << x << ", " << y << ") channel " << c;
+    }
+  }
+  // Any other encoding: an Error naming it.
+  try {
+    ImageToLinearRgb(MakeImage(4, 4, "bayer_xyzw8", 1), false);
+    ADD_FAILURE() << "bayer_xyzw8 accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'bayer_xyzw8'"), std::string::npos)
+        << e.what();
+  }
+  try {
+    ImageToLinearRgb(MakeImage(4, 4, "yuv422", 2), false);
+    ADD_FAILURE() << "yuv422 accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'yuv422'"), std::string::npos)
+        << e.what();
+  }
+}
+
+// Binning and ROI: the delivered image is the ROI of the sensor, binned.
+TEST(Conversions, CameraInfoBinningAndRoi) {
+  auto full_info = MakeInfo(640, 480, 500, 310.2, 245.7);
+  Camera full;
+  CameraFromCameraInfo(full_info, &full, nullptr);
+  auto info = full_info;
+  info.roi.x_offset = 100;
+  info.roi.y_offset = 60;
+  info.roi.width = 400;
+  info.roi.height = 300;
+  info.binning_x = 2;
+  info.binning_y = 3;
+  Camera cam;
+  CameraFromCameraInfo(info, &cam, nullptr);
+  EXPECT_EQ(cam.width, 200);
+  EXPECT_EQ(cam.height, 100);
+  EXPECT_DOUBLE_EQ(cam.fx, 250.0);
+  EXPECT_NEAR(cam.fy, 500.0 / 3, 1e-12);
+  // Binned pixel (j, i) covers sensor pixels x = 100 + 2j, 100 + 2j + 1 and
+  // y = 60 + 3i .. 60 + 3i + 2; its centre (core j + 0.5, i + 0.5) is the
+  // mean of their centres: core x = 100 + 2j + 1, y = 60 + 3i + 1.5. A 3D
+  // point on that ray in the full camera lands on the binned pixel centre.
+  for (int j : {0, 10, 199}) {
+    for (int i : {0, 7, 99}) {
+      const double u = 100 + 2 * j + 1, v = 60 + 3 * i + 1.5;
+      const Eigen::Vector3d X((u - full.cx) / full.fx * 3.0,
+                              (v - full.cy) / full.fy * 3.0, 3.0);
+      ASSERT_NEAR(full.ProjectCam(X).x(), u, 1e-9);
+      const Eigen::Vector2d px = cam.ProjectCam(X);
+      EXPECT_NEAR(px.x(), j + 0.5, 1e-9) << j << " " << i;
+      EXPECT_NEAR(px.y(), i + 0.5, 1e-9) << j << " " << i;
+    }
+  }
+  // Binning 0 and 1 are both "none"; roi width/height 0 = full sensor.
+  auto none = full_info;
+  none.binning_x = 1;
+  none.binning_y = 0;
+  CameraFromCameraInfo(none, &cam, nullptr);
+  EXPECT_EQ(cam.width, 640);
+  EXPECT_EQ(cam.height, 480);
+  EXPECT_DOUBLE_EQ(cam.cx, full.cx);
+  EXPECT_DOUBLE_EQ(cam.fy, full.fy);
+  // Binning only: odd widths round down.
+  auto binned = MakeInfo(641, 481, 500, 320, 240);
+  binned.binning_x = binned.binning_y = 2;
+  CameraFromCameraInfo(binned, &cam, nullptr);
+  EXPECT_EQ(cam.width, 320);
+  EXPECT_EQ(cam.height, 240);
+  EXPECT_DOUBLE_EQ(cam.cx, (320 + 0.5) / 2);
+  // An ROI outside the sensor is refused.
+  auto outside = info;
+  outside.roi.x_offset = 300;  // 300 + 400 > 640
+  EXPECT_THROW(CameraFromCameraInfo(outside, &cam, nullptr), Error);
+}
+
+// Rectified mode: the camera comes from P, D is ignored.
+TEST(Conversions, CameraInfoRectifiedUsesP) {
+  auto info = MakeInfo(640, 480, 500, 319.5, 239.5);
+  info.D = {-0.2, 0.05, 0.001, 0.002, 0.0};
+  info.P = {480, 0, 321.5, 0, 0, 470, 235.5, 0, 0, 0, 1, 0};
+  Camera cam;
+  Distortion d;
+  CameraFromCameraInfo(info, &cam, &d, true);
+  EXPECT_DOUBLE_EQ(cam.fx, 480.0);
+  EXPECT_DOUBLE_EQ(cam.fy, 470.0);
+  EXPECT_DOUBLE_EQ(cam.cx, 322.0);
+  EXPECT_DOUBLE_EQ(cam.cy, 236.0);
+  EXPECT_TRUE(d.IsNone());
+  // Default mode still uses K and D.
+  CameraFromCameraInfo(info, &cam, &d);
+  EXPECT_DOUBLE_EQ(cam.fx, 500.0);
+  EXPECT_DOUBLE_EQ(cam.cx, 320.0);
+  EXPECT_FALSE(d.IsNone());
+  // A stereo right camera's baseline term is accepted and ignored.
+  auto right = info;
+  right.P[3] = -480 * 0.12;
+  CameraFromCameraInfo(right, &cam, &d, true);
+  EXPECT_DOUBLE_EQ(cam.fx, 480.0);
+  EXPECT_DOUBLE_EQ(cam.cx, 322.0);
+  // Binning / ROI apply to P too.
+  auto binned = info;
+  binned.binning_x = binned.binning_y = 2;
+  CameraFromCameraInfo(binned, &cam, &d, true);
+  EXPECT_EQ(cam.width, 320);
+  EXPECT_DOUBLE_EQ(cam.fx, 240.0);
+  EXPECT_DOUBLE_EQ(cam.cx, 161.0);
+  // An all-zero P is an error in rectified mode (not in the default mode).
+  auto zero = info;
+  zero.P.fill(0.0);
+  try {
+    CameraFromCameraInfo(zero, &cam, &d, true);
+    ADD_FAILURE() << "all-zero P accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("P is all zero"), std::string::npos)
+        << e.what();
+  }
+  CameraFromCameraInfo(zero, &cam, &d);
+  EXPECT_DOUBLE_EQ(cam.fx, 500.0);
+}
+
+TEST(Conversions, Depth16IsRep118Millimetres) {
+  cv::Mat depth(1, 9, CV_32FC1);
+  const float in[9] = {0.f,  1.2344f, 1.2346f,  65.535f, 65.6f,
+                       -1.f, NAN,     INFINITY, 0.0004f};
+  const uint16_t want[9] = {0, 1234, 1235, 65535, 0, 0, 0, 0, 0};
+  for (int i = 0; i < 9; ++i) depth.at<float>(0, i) = in[i];
+  sensor_msgs::Image m = DepthToMsg16(depth);
+  EXPECT_EQ(m.encoding, "16UC1");
+  EXPECT_EQ(m.width, 9u);
+  EXPECT_EQ(m.height, 1u);
+  EXPECT_EQ(m.step, 18u);
+  EXPECT_EQ(m.is_bigendian, 0);
+  ASSERT_EQ(m.data.size(), 18u);
+  for (int i = 0; i < 9; ++i) {
+    uint16_t v;
+    std::memcpy(&v, &m.data[2 * i], 2);
+    EXPECT_EQ(v, want[i]) << "depth " << in[i];
+  }
+  // The 32FC1 output of the same map: metres, NaN where unknown.
+  sensor_msgs::Image f = DepthToMsg(depth);
+  EXPECT_EQ(f.encoding, "32FC1");
+  for (int i = 0; i < 9; ++i) {
+    float v;
+    std::memcpy(&v, &f.data[4 * i], 4);
+    if (in[i] > 0 && std::isfinite(in[i])) {
+      EXPECT_FLOAT_EQ(v, in[i]);
+    } else {
+      EXPECT_TRUE(std::isnan(v)) << "depth " << in[i];
+    }
+  }
+  EXPECT_THROW(DepthToMsg16(cv::Mat(2, 2, CV_64FC1)), Error);
+}
+
+TEST(Conversions, StripLeadingSlash) {
+  EXPECT_EQ(StripLeadingSlash("/camera"), "camera");
+  EXPECT_EQ(StripLeadingSlash("//a/b/"), "a/b/");
+  EXPECT_EQ(StripLeadingSlash("map"), "map");
+  EXPECT_EQ(StripLeadingSlash("/"), "");
+  EXPECT_EQ(StripLeadingSlash(""), "");
 }
 
 }  // namespace

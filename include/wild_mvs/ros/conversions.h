@@ -44,8 +44,33 @@ namespace ros1 {
 // far outside the image, a non-zero skew, and distortion models other than
 // plumb_bob / rational_polynomial (returned in *distortion with coefficients
 // k1 k2 p1 p2 k3; rational_polynomial with k4..k6 != 0 is rejected).
+//
+// Binning and ROI. info.width/height, K and P describe the full-resolution
+// sensor; the image actually delivered is the ROI (x_offset, y_offset,
+// width, height; a width or height of 0 = from the offset to the sensor's
+// edge, so the all-zero roi = the full sensor) of it, then binned by
+// binning_x/binning_y (0 or 1 = none). So the camera returned describes the
+// delivered image:
+//   width  = (roi.width ? roi.width : info.width - x_offset) / bx  (floor)
+//   fx'    = fx / bx
+//   cx'    = (cx_core - x_offset) / bx          (core pixel centres)
+//          = (K[2] + 0.5 - x_offset) / bx       (from ROS K)
+// and the same in y. The formula is exact for pixel centres in the core's
+// convention (a binned pixel covers bx full-resolution pixels, its left edge
+// at x_offset + bx * j); in ROS terms cx_ros' = (K[2] + 0.5 - x_offset) / bx
+// - 0.5, which differs from image_geometry's (K[2] - x_offset) / bx by
+// (bx - 1) / (2 bx) pixels. An ROI reaching outside the sensor is rejected.
+// Distortion coefficients act on normalised coordinates and are unchanged.
+//
+// Rectified mode (rectified = true; for image_rect topics): the camera comes
+// from P instead (fx = P[0], fy = P[5], cx = P[2], cy = P[6], then the same
+// ROI / binning adjustment), D is ignored and *distortion is kNone. A P with
+// a non-zero translation P[3] / P[7] (a stereo right camera: -fx * baseline)
+// is accepted and the translation ignored (the pose comes from tf). An
+// all-zero P (an uncalibrated camera), a non-zero skew P[1], or P[10] != 1
+// is rejected.
 void CameraFromCameraInfo(const sensor_msgs::CameraInfo& info, Camera* camera,
-                          Distortion* distortion);
+                          Distortion* distortion, bool rectified = false);
 // A CameraInfo for a pinhole camera (no distortion, identity R, P = [K 0]).
 sensor_msgs::CameraInfo CameraInfoFromCamera(const Camera& camera);
 
@@ -61,9 +86,12 @@ geometry_msgs::Pose PoseFromCamera(const Camera& camera);
 
 // --- Images ---------------------------------------------------------------
 // An input image (mono8/16, rgb8/16, bgr8/16, rgba8, bgra8; 32FC1/32FC3 are
-// taken as linear) as the core's CV_32FC3 linear RGB. Rejects unknown or
-// depth-like encodings (16UC1 "depth"), big-endian multi-byte data, a step
-// shorter than a row, and data shorter than step * height.
+// taken as linear; Bayer bayer_rggb8, bayer_bggr8, bayer_gbrg8, bayer_grbg8
+// and their 16-bit bayer_*16 variants, demosaiced bilinearly with
+// cv::cvtColor) as the core's CV_32FC3 linear RGB. Rejects unknown or
+// depth-like encodings (16UC1 "depth") with an Error naming the encoding,
+// big-endian multi-byte data, a step shorter than a row, and data shorter
+// than step * height.
 cv::Mat ImageToLinearRgb(const sensor_msgs::Image& msg, bool linearize);
 // A sensor_msgs/CompressedImage (JPEG / PNG) decoded with cv::imdecode.
 cv::Mat CompressedToLinearRgb(const sensor_msgs::CompressedImage& msg,
@@ -74,11 +102,21 @@ cv::Mat FloatImageFromMsg(const sensor_msgs::Image& msg, int channels,
 
 // REP 118 depth image from a core depth map (0 -> NaN).
 sensor_msgs::Image DepthToMsg(const cv::Mat& depth);
+// REP 118 16-bit depth image (encoding 16UC1, millimetres rounded to the
+// nearest mm, 0 = unknown) from a core depth map (CV_32FC1 metres, 0 =
+// unknown). Depths <= 0, non-finite, or rounding above 65535 mm (65.535 m)
+// become 0.
+sensor_msgs::Image DepthToMsg16(const cv::Mat& depth);
 sensor_msgs::Image ConfidenceToMsg(const cv::Mat& confidence);
 sensor_msgs::Image NormalsToMsg(const cv::Mat& normals);  // 0 -> NaN
 
 // An rgb8 (sRGB) image of a linear RGB CV_32FC3 image resized to w x h.
 sensor_msgs::Image ColorToMsg(const cv::Mat& linear_rgb, int w, int h);
+
+// --- Frames ---------------------------------------------------------------
+// frame_id without its leading '/' characters (all of them): tf2 rejects
+// frame ids that start with '/', which ROS 1 tf allowed ("/camera").
+std::string StripLeadingSlash(const std::string& frame_id);
 
 // --- DepthView ------------------------------------------------------------
 // Fills depth, confidence, normals, camera_info and camera_pose (header,
