@@ -23,7 +23,6 @@
 #include <deque>
 #include <map>
 #include <mutex>
-#include <opencv2/calib3d.hpp>
 #include <pluginlib/class_list_macros.hpp>
 #include <set>
 #include <thread>
@@ -33,17 +32,10 @@
 #include "wild_mvs/ros/drop_counter.h"
 #include "wild_mvs/ros/params_ros.h"
 #include "wild_mvs/ros/stream_reconstructor.h"
+#include "wild_mvs/ros/undistorter.h"
 
 namespace wild_mvs {
 namespace ros1 {
-// TEMP-MERGE: until conversions.h has them.
-static std::string StripLeadingSlash(const std::string& f) {
-  const size_t n = f.find_first_not_of('/');
-  return n == std::string::npos ? std::string() : f.substr(n);
-}
-static sensor_msgs::Image DepthToMsg16(const cv::Mat& d) {
-  return DepthToMsg(d);
-}
 
 struct DepthNode::Impl {
   struct Frame {
@@ -70,8 +62,9 @@ struct DepthNode::Impl {
   // Periodic work about machine time (scheduling, diagnostics): steady
   // timers, so that it goes on when /clock pauses or stops (sim time).
   ros::SteadyTimer tick_timer, diag_timer;
-  std::string image_topic, info_topic;  // resolved input names
-  bool rectified = false;               // camera from P, D ignored
+  std::string image_topic, info_topic;       // resolved input names
+  bool rectified = false;                    // camera from P, D ignored
+  std::unique_ptr<Undistorter> undistorter;  // front end only
   std::unique_ptr<diagnostic_updater::Updater> updater;
   std::unique_ptr<StreamReconstructor> stream;
 
@@ -357,7 +350,7 @@ struct DepthNode::Impl {
     Camera cam;
     Distortion dist;
     try {
-      CameraFromCameraInfo(*f.info, &cam, &dist);
+      CameraFromCameraInfo(*f.info, &cam, &dist, rectified);
     } catch (const Error& e) {
       Drop(info_topic, "invalid camera_info", e.what());
       return;
@@ -376,14 +369,13 @@ struct DepthNode::Impl {
           Msg(image.cols, "x", image.rows, " vs ", cam.width, "x", cam.height));
       return;
     }
-    if (!dist.IsNone()) {
-      const cv::Mat K = (cv::Mat_<double>(3, 3) << f.info->K[0], 0,
-                         f.info->K[2], 0, f.info->K[4], f.info->K[5], 0, 0, 1);
-      const cv::Mat D = (cv::Mat_<double>(1, 5) << dist.k1, dist.k2, dist.p1,
-                         dist.p2, dist.k3);
-      cv::Mat und;
-      cv::undistort(image, und, K, D, K);
-      image = und;
+    // Undistorted with maps built once per camera_info (a rectified
+    // input passes through: the camera is P's).
+    try {
+      image = undistorter->Apply(*f.info, image, &cam);
+    } catch (const Error& e) {
+      Drop(info_topic, "invalid camera_info", e.what());
+      return;
     }
     if (!LookupPose(f, &cam)) return;
     StreamReconstructor::FrameStatus status;
@@ -578,6 +570,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   };
   m.rectified = o.rectified || ends_with(m.image_topic, "/image_rect") ||
                 ends_with(m.image_topic, "/image_rect_color");
+  m.undistorter = std::make_unique<Undistorter>(m.rectified);
   m.info_sub = m.nh.subscribe(m.info_topic, 20, &Impl::OnInfo, &m);
   m.it = std::make_unique<image_transport::ImageTransport>(m.nh);
   const std::vector<std::string> plugins = m.it->getLoadableTransports();

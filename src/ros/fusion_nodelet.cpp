@@ -38,11 +38,6 @@ namespace wild_mvs {
 namespace ros1 {
 
 namespace fs = std::filesystem;
-// TEMP-MERGE
-static std::string StripLeadingSlash(const std::string& f) {
-  const size_t n = f.find_first_not_of('/');
-  return n == std::string::npos ? std::string() : f.substr(n);
-}
 
 struct FusionNode::Impl {
   // A view waiting to be fused, and the maps of fused views.
