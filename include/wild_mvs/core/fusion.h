@@ -2,7 +2,7 @@
 // cloud with a multi-view geometric consistency check, streaming with
 // bounded memory.
 //
-// Algorithm (ALGORITHM.md section 6; the check COLMAP and OpenMVS use):
+// Algorithm (docs/ALGORITHM.md section 6; the check COLMAP and OpenMVS use):
 //  - A depth sample of view v (pixel with depth > 0, confidence >=
 //    min_confidence, not masked, inside the bounding box) is back-projected
 //    to a world point X with world normal N. It is checked against every

@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors. Global view selection (paper section 5.1 /
-// ALGORITHM.md section 1): the image-level neighbourhood N of a reference
+// docs/ALGORITHM.md section 1): the image-level neighbourhood N of a reference
 // view R, chosen from the structure-from-motion features both views share.
 #pragma once
 

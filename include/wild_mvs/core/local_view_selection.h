@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors. Local (per-pixel) view selection (paper section
-// 5.2 / ALGORITHM.md section 3): the active set A of up to m views used to
+// 5.2 / docs/ALGORITHM.md section 3): the active set A of up to m views used to
 // match one pixel, favouring spread epipolar directions.
 #pragma once
 

@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors. MPGC stereo matching of one pixel (paper
-// section 6.2 / ALGORITHM.md section 4): depth along the ray plus the two
+// section 6.2 / docs/ALGORITHM.md section 4): depth along the ray plus the two
 // per-pixel depth offsets (the normal) and one colour scale per active view
 // and channel, by linearised least squares; NCC for confidence and
 // convergence; the paper's schedule. Local view selection (section 3) runs

@@ -1,6 +1,6 @@
 // Copyright wild_mvs authors. The patch (surface) model of the paper's
-// stereo matching (section 6.2, ALGORITHM.md section 4) and the sampling of
-// the neighbour images under it.
+// stereo matching (section 6.2, docs/ALGORITHM.md section 4) and the sampling
+// of the neighbour images under it.
 //
 // The n x n window centred at pixel (s, t) of the reference view R is a
 // surface whose point at window offset (i, j) is

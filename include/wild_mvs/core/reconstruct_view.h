@@ -1,6 +1,6 @@
 // Copyright wild_mvs authors. The per-view MVS driver: global view
 // selection, rescaling, seeding, region growing with MPGC matching, for one
-// reference view (Goesele et al. 2007; ALGORITHM.md sections 1-5).
+// reference view (Goesele et al. 2007; docs/ALGORITHM.md sections 1-5).
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors. Region growing (paper section 6.1 /
-// ALGORITHM.md section 5), parallel over image tiles and deterministic.
+// docs/ALGORITHM.md section 5), parallel over image tiles and deterministic.
 //
 // The image is cut into tiles coloured 2 x 2 (same-coloured tiles never
 // touch). Growth runs in phases: in a phase every tile of one colour grows in
