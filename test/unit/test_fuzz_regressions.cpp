@@ -109,8 +109,9 @@ TEST(FuzzRegressions, PlyFaceIndexOverIntMaxIsRefused) {
       const std::string what = e.what();
       EXPECT_NE(what.find(path), std::string::npos) << what;
       // The mesh reader stops earlier, at a face of 0 vertices.
-      if (!mesh)
+      if (!mesh) {
         EXPECT_NE(what.find("refers to vertex"), std::string::npos) << what;
+      }
     }
   }
   std::filesystem::remove_all(dir);
