@@ -5,6 +5,16 @@
 # Only what the ROS layer really uses is asked for: no cv_bridge (images are
 # converted by src/ros/conversions.cpp, which validates every field), no
 # pcl_ros (PointCloud2 is filled directly).
+# The devel space: rosrun skips every executable under <package>/build/
+# (its `find ! -regex ".*$pkgdir/build/.*"`), so the README's build folder
+# <source>/build keeps its devel space beside it, in <source>/devel (git
+# ignores it). Other build folders (build-fuzz, out-of-tree) keep the
+# catkin default <build>/devel. An explicit -DCATKIN_DEVEL_PREFIX wins.
+if(NOT CATKIN_DEVEL_PREFIX AND
+   CMAKE_BINARY_DIR STREQUAL "${CMAKE_SOURCE_DIR}/build")
+  set(CATKIN_DEVEL_PREFIX "${CMAKE_SOURCE_DIR}/devel")
+endif()
+
 set(WILD_MVS_ROS_COMPONENTS
   roscpp nodelet pluginlib std_msgs std_srvs sensor_msgs geometry_msgs
   visualization_msgs diagnostic_msgs diagnostic_updater image_transport
