@@ -15,11 +15,40 @@ if(NOT CATKIN_DEVEL_PREFIX AND
   set(CATKIN_DEVEL_PREFIX "${CMAKE_SOURCE_DIR}/devel")
 endif()
 
+# Relocatable binaries: the nodes and tools (lib/wild_mvs/ of the devel or
+# install space) find libwild_mvs_ros.so in lib/ through $ORIGIN, the same
+# way in the devel space and after `cmake --install` (no RPATH rewrite at
+# install time, which fails on catkin's build RPATH).
+set(CMAKE_BUILD_WITH_INSTALL_RPATH ON)
+set(CMAKE_INSTALL_RPATH "$ORIGIN/..;$ORIGIN/../lib")
+
 set(WILD_MVS_ROS_COMPONENTS
   roscpp nodelet pluginlib std_msgs std_srvs sensor_msgs geometry_msgs
   visualization_msgs diagnostic_msgs diagnostic_updater image_transport
   tf2 tf2_ros tf2_msgs rosbag message_generation)
+# catkin installs its setup files (setup.bash, _setup_util.py, ...) to the
+# absolute CMAKE_INSTALL_PREFIX of configure time, which
+# `cmake --install build --prefix P` does not move: they are installed
+# below with relative destinations instead, so that any prefix works.
+if(NOT DEFINED CATKIN_INSTALL_INTO_PREFIX_ROOT)
+  set(CATKIN_INSTALL_INTO_PREFIX_ROOT FALSE)
+  set(WILD_MVS_INSTALL_SETUP_FILES ON)
+endif()
 find_package(catkin REQUIRED COMPONENTS ${WILD_MVS_ROS_COMPONENTS})
+if(WILD_MVS_INSTALL_SETUP_FILES AND NOT CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+  set(_ws ${CMAKE_BINARY_DIR}/catkin_generated/installspace)
+  install(CODE "
+    if(NOT EXISTS \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/.catkin\")
+      file(WRITE \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/.catkin\" \"\")
+    endif()")
+  # the devel space's _setup_util.py comes from the same template with the
+  # same values (it finds its workspace from its own location)
+  install(PROGRAMS ${CATKIN_DEVEL_PREFIX}/_setup_util.py ${_ws}/env.sh
+    DESTINATION .)
+  install(FILES ${_ws}/setup.bash ${_ws}/setup.sh ${_ws}/setup.zsh
+    ${_ws}/local_setup.bash ${_ws}/local_setup.sh ${_ws}/local_setup.zsh
+    ${_ws}/.rosinstall DESTINATION .)
+endif()
 
 add_message_files(DIRECTORY msg FILES
   DepthView.msg TrackedPoint.msg SparsePoints.msg)

@@ -17,7 +17,7 @@ for f in setup.bash lib/wild_mvs/depth_node lib/wild_mvs/fusion_node \
          lib/libwild_mvs_ros.so bin/wild_mvs share/wild_mvs/package.xml \
          share/wild_mvs/nodelet_plugins.xml share/wild_mvs/launch/reconstruct_bag.launch \
          share/wild_mvs/config/depth_node.yaml share/wild_mvs/config/wild_mvs.rviz \
-         include/wild_mvs/msg/DepthView.h include/wild_mvs/srv/SaveCloud.h; do
+         include/wild_mvs/DepthView.h include/wild_mvs/SaveCloud.h; do
   [ -e "$PREFIX/$f" ] || { echo "FAIL: not installed: $f" >&2; exit 1; }
 done
 # Only the install space: a clean environment, not the devel space.
