@@ -98,6 +98,9 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
   # arguments (roslaunch --nodes / --dump-params).
   find_package(roslaunch REQUIRED)
   roslaunch_add_file_check(launch IGNORE_UNSET_ARGS)
+  # roslaunch-check runs `python3` from PATH: Debian's, not a pyenv one.
+  set_tests_properties(_ctest_${PROJECT_NAME}_roslaunch-check_launch PROPERTIES
+    ENVIRONMENT "PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin")
   add_test(NAME ros_launch_files
     COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_launch_files.sh
             ${CATKIN_DEVEL_PREFIX})
