@@ -115,6 +115,11 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
               ${CMAKE_BINARY_DIR} ${CATKIN_DEVEL_PREFIX})
     set_tests_properties(ros_${space}_space PROPERTIES TIMEOUT 300)
   endforeach()
+  # reconstruct_bag.launch on a bag with other topic names ends by itself.
+  add_test(NAME ros_own_bag
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_own_bag.sh
+            ${CATKIN_DEVEL_PREFIX} ${CMAKE_CURRENT_SOURCE_DIR})
+  set_tests_properties(ros_own_bag PROPERTIES TIMEOUT 600)
 
   file(GLOB WILD_MVS_ROSTESTS CONFIGURE_DEPENDS test/ros/*.test)
   foreach(file ${WILD_MVS_ROSTESTS})
