@@ -43,6 +43,16 @@ endif()
 # core and io libraries are static and PIC, linked into libwild_mvs_ros.so,
 # the nodes and the CLI; they and the headers are installed for packages
 # that build on wild_mvs (catkin_package LIBRARIES).
+# The installed binaries are relocatable: the nodes and tools
+# (lib/wild_mvs/ of the devel or install space) and the libraries (lib/)
+# find the project's libraries in lib/ through $ORIGIN, the same way in the
+# devel space and after `cmake --install` (no RPATH rewrite at install
+# time, which fails on catkin's build RPATH). Tests and fuzz harnesses keep
+# CMake's build RPATH.
+set(WILD_MVS_INSTALLED_TARGETS ${WILD_MVS_ROS_EXECUTABLES} wild_mvs wild_mvs_ros
+  wild_mvs_core wild_mvs_io)
+set_target_properties(${WILD_MVS_INSTALLED_TARGETS} PROPERTIES
+  BUILD_WITH_INSTALL_RPATH ON INSTALL_RPATH "$ORIGIN/..;$ORIGIN/../lib")
 install(TARGETS ${WILD_MVS_ROS_EXECUTABLES}
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 install(TARGETS wild_mvs_ros wild_mvs_core wild_mvs_io

@@ -15,13 +15,6 @@ if(NOT CATKIN_DEVEL_PREFIX AND
   set(CATKIN_DEVEL_PREFIX "${CMAKE_SOURCE_DIR}/devel")
 endif()
 
-# Relocatable binaries: the nodes and tools (lib/wild_mvs/ of the devel or
-# install space) find libwild_mvs_ros.so in lib/ through $ORIGIN, the same
-# way in the devel space and after `cmake --install` (no RPATH rewrite at
-# install time, which fails on catkin's build RPATH).
-set(CMAKE_BUILD_WITH_INSTALL_RPATH ON)
-set(CMAKE_INSTALL_RPATH "$ORIGIN/..;$ORIGIN/../lib")
-
 set(WILD_MVS_ROS_COMPONENTS
   roscpp nodelet pluginlib std_msgs std_srvs sensor_msgs geometry_msgs
   visualization_msgs diagnostic_msgs diagnostic_updater image_transport
