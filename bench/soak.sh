@@ -34,11 +34,12 @@ if ! $PY -c "import matplotlib" 2>/dev/null; then
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-matplotlib >/dev/null ||
     echo "soak: could not install python3-matplotlib: no plot" >&2
 fi
-[ -x "$BUILD_DIR/devel/lib/wild_mvs/depth_node" ] ||
-  { echo "soak: no ROS build in $BUILD_DIR (run wild_mvs_build)" >&2; exit 1; }
+DEVEL=$(wild_mvs_devel_dir)
+[ -x "$DEVEL/lib/wild_mvs/depth_node" ] ||
+  { echo "soak: no ROS build in $BUILD_DIR (devel space $DEVEL; run wild_mvs_build)" >&2; exit 1; }
 set +u
-source "$BUILD_DIR/devel/setup.bash"
-LIB="$BUILD_DIR/devel/lib/wild_mvs"
+source "$DEVEL/setup.bash"
+LIB="$DEVEL/lib/wild_mvs"
 
 "$LIB/wild_mvs_to_bag" "$DATASET" "$OUT/soak.bag" --rate 2 >/dev/null
 

@@ -37,6 +37,40 @@ if(TARGET wild_mvs_to_bag)
             ${CMAKE_BINARY_DIR}/bin/wild_mvs_to_bag)
 endif()
 
+# --- install space -------------------------------------------------------------
+# `cmake --install build --prefix P` gives a self-contained catkin install
+# space (source P/setup.bash; rosrun / roslaunch / nodelet from there). The
+# core and io libraries are static and PIC, linked into libwild_mvs_ros.so,
+# the nodes and the CLI; they and the headers are installed for packages
+# that build on wild_mvs (catkin_package LIBRARIES).
+# The installed binaries are relocatable: the nodes and tools
+# (lib/wild_mvs/ of the devel or install space) and the libraries (lib/)
+# find the project's libraries in lib/ through $ORIGIN, the same way in the
+# devel space and after `cmake --install` (no RPATH rewrite at install
+# time, which fails on catkin's build RPATH). Tests and fuzz harnesses keep
+# CMake's build RPATH.
+set(WILD_MVS_INSTALLED_TARGETS ${WILD_MVS_ROS_EXECUTABLES} wild_mvs wild_mvs_ros
+  wild_mvs_core wild_mvs_io)
+set_target_properties(${WILD_MVS_INSTALLED_TARGETS} PROPERTIES
+  BUILD_WITH_INSTALL_RPATH ON INSTALL_RPATH "$ORIGIN/..;$ORIGIN/../lib")
+install(TARGETS ${WILD_MVS_ROS_EXECUTABLES}
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+install(TARGETS wild_mvs_ros wild_mvs_core wild_mvs_io
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  RUNTIME DESTINATION ${CATKIN_GLOBAL_BIN_DESTINATION})
+# The CLI in P/bin (on PATH after sourcing P/setup.bash); `wild_mvs to-bag`
+# finds P/lib/wild_mvs/wild_mvs_to_bag from there.
+install(TARGETS wild_mvs RUNTIME DESTINATION ${CATKIN_GLOBAL_BIN_DESTINATION})
+install(DIRECTORY include/ DESTINATION ${CATKIN_GLOBAL_INCLUDE_DESTINATION})
+install(DIRECTORY launch config
+  DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})
+install(FILES nodelet_plugins.xml
+  DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})
+# (package.xml, the messages and the service are installed by catkin.)
+catkin_install_python(PROGRAMS src/nodes/finish_when_idle.py
+  DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
 # --- tests -------------------------------------------------------------------
 if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
   # Plain gtests of the ROS layer (no master needed).
@@ -68,6 +102,35 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
     target_compile_options(${name} PRIVATE ${WILD_MVS_WARNINGS})
     list(APPEND WILD_MVS_ROSTEST_TARGETS ${name})
   endforeach()
+  # Every launch file parses and names only nodes of packages that
+  # package.xml declares (roslaunch-check; -i: `bag`, `index`, `count` have
+  # no default). test/ros/test_launch_files.sh then expands them with
+  # arguments (roslaunch --nodes / --dump-params).
+  find_package(roslaunch REQUIRED)
+  roslaunch_add_file_check(launch IGNORE_UNSET_ARGS)
+  # roslaunch-check runs `python3` from PATH: Debian's, not a pyenv one.
+  set_tests_properties(_ctest_${PROJECT_NAME}_roslaunch-check_launch PROPERTIES
+    ENVIRONMENT "PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin")
+  add_test(NAME ros_launch_files
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_launch_files.sh
+            ${CATKIN_DEVEL_PREFIX})
+  set_tests_properties(ros_launch_files PROPERTIES TIMEOUT 120)
+
+  # The devel space and the install space work with the standard tools:
+  # rosrun of the nodes and a nodelet from another directory, and
+  # `cmake --install` to a temporary prefix, then rosrun from there.
+  foreach(space devel install)
+    add_test(NAME ros_${space}_space
+      COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_${space}_space.sh
+              ${CMAKE_BINARY_DIR} ${CATKIN_DEVEL_PREFIX})
+    set_tests_properties(ros_${space}_space PROPERTIES TIMEOUT 300)
+  endforeach()
+  # reconstruct_bag.launch on a bag with other topic names ends by itself.
+  add_test(NAME ros_own_bag
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_own_bag.sh
+            ${CATKIN_DEVEL_PREFIX} ${CMAKE_CURRENT_SOURCE_DIR})
+  set_tests_properties(ros_own_bag PROPERTIES TIMEOUT 600)
+
   file(GLOB WILD_MVS_ROSTESTS CONFIGURE_DEPENDS test/ros/*.test)
   foreach(file ${WILD_MVS_ROSTESTS})
     add_rostest(${file} DEPENDENCIES ${WILD_MVS_ROSTEST_TARGETS}

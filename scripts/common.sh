@@ -8,6 +8,24 @@ export ROS_MASTER_URI=${ROS_MASTER_URI:-http://localhost:11311}
 BUILD_DIR="${BUILD_DIR:-$WILD_MVS_ROOT/build}"
 JOBS="${JOBS:-$(nproc)}"
 
+# The catkin devel space of $BUILD_DIR (setup.bash, lib/wild_mvs/<nodes>):
+# <source>/devel for the default build folder <source>/build (rosrun skips
+# everything under <package>/build/; see cmake/ros_setup.cmake), else
+# $BUILD_DIR/devel; a configured build's CMakeCache.txt has the last word.
+wild_mvs_devel_dir() {
+  local d=""
+  [ -f "$BUILD_DIR/CMakeCache.txt" ] &&
+    d=$(sed -n 's/^CATKIN_DEVEL_PREFIX:[A-Z]*=//p' "$BUILD_DIR/CMakeCache.txt")
+  if [ -z "$d" ]; then
+    if [ "$(realpath -m "$BUILD_DIR")" = "$WILD_MVS_ROOT/build" ]; then
+      d="$WILD_MVS_ROOT/devel"
+    else
+      d="$BUILD_DIR/devel"
+    fi
+  fi
+  echo "$d"
+}
+
 # ccache, when installed, makes rebuilds and other checkouts cheap.
 CCACHE_ARGS=()
 if command -v ccache >/dev/null 2>&1; then

@@ -36,11 +36,12 @@ done
 DATASET=$(cd "$DATASET" && pwd)  # roslaunch runs nodes in ~/.ros: absolute paths
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
-LIB="$BUILD_DIR/devel/lib/wild_mvs"
+DEVEL=$(wild_mvs_devel_dir)
+LIB="$DEVEL/lib/wild_mvs"
 [ -x "$LIB/depth_node" ] && [ -x "$LIB/wild_mvs_to_bag" ] ||
-  { echo "ros_reconstruct.sh: no ROS build in $BUILD_DIR (run scripts/run_demo.sh or wild_mvs_build)" >&2; exit 1; }
+  { echo "ros_reconstruct.sh: no ROS build in $BUILD_DIR (devel space $DEVEL; run scripts/run_demo.sh or wild_mvs_build)" >&2; exit 1; }
 set +u
-source "$BUILD_DIR/devel/setup.bash"
+source "$DEVEL/setup.bash"
 PORT=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI=http://localhost:$PORT
 export ROS_LOG_DIR="$OUT/ros_log"
@@ -50,8 +51,10 @@ size_args=()
 [ "$SIZE" = 0 ] || size_args=(--max-image-size "$SIZE")
 "$LIB/wild_mvs_to_bag" "$DATASET" "$OUT/input.bag" --rate "$RATE" "${size_args[@]}"
 rc=0
+# config/sample.yaml: the small-scene overrides (every frame of the bundled
+# sample's short arc is a keyframe); a later config:=... argument wins.
 roslaunch -p "$PORT" wild_mvs reconstruct_bag.launch bag:="$OUT/input.bag" \
-  output:="$OUT/cloud.ply" "${LAUNCH_ARGS[@]}" >"$OUT/roslaunch.log" 2>&1 || rc=$?
+  output:="$OUT/cloud.ply" config:="$WILD_MVS_ROOT/config/sample.yaml" "${LAUNCH_ARGS[@]}" >"$OUT/roslaunch.log" 2>&1 || rc=$?
 end=$(date +%s.%N)
 grep -E "keyframe [0-9]+ \(rev|ERROR|FATAL" "$OUT/roslaunch.log" | sed 's/^/  /' || true
 seconds=$(/usr/bin/python3 -c "print(round($end-$start,1))")

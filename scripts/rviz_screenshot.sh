@@ -19,7 +19,7 @@ for t in rviz Xvfb /usr/bin/import; do
   command -v "$t" >/dev/null || { echo "rviz_screenshot.sh: $t missing (apt-get install rviz xvfb imagemagick)" >&2; exit 1; }
 done
 set +u
-source "$BUILD_DIR/devel/setup.bash"
+source "$(wild_mvs_devel_dir)/setup.bash"
 PORT=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI=http://localhost:$PORT
 DISP=$((90 + RANDOM % 100))
@@ -28,7 +28,7 @@ xvfb=$!
 export DISPLAY=":$DISP"
 TMP=$(mktemp -d)
 roslaunch -p "$PORT" wild_mvs reconstruct_bag.launch bag:="$BAG" output:="$TMP/cloud.ply" \
-  finish:=false rviz:=true "$@" >"$TMP/roslaunch.log" 2>&1 &
+  finish:=false rviz:=true config:="$WILD_MVS_ROOT/config/sample.yaml" "$@" >"$TMP/roslaunch.log" 2>&1 &
 launch=$!
 trap 'kill -INT $launch 2>/dev/null; sleep 3; kill $xvfb 2>/dev/null; rm -rf "$TMP"' EXIT
 /usr/bin/python3 - "$VIEWS" <<'PY'

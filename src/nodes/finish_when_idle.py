@@ -1,90 +1,143 @@
 #!/usr/bin/env python3
 # Copyright wild_mvs authors.
-"""Ends a bag reconstruction (launch/reconstruct_bag.launch): waits until the
-bag has been played (no image for ~image_idle s after the first one) and the
-depth node is idle (nothing pending in its diagnostics and no new depth view
-for ~view_idle s), then calls the fusion node's ~save service and exits; the
-launch file marks this node required, so everything shuts down after it."""
+"""Ends a bag reconstruction (launch/reconstruct_bag.launch) whatever the
+topics are called: it only reads /diagnostics. Once the depth node's
+"frames received" went above 0 and then stopped increasing for ~image_idle
+s (the bag is played), its "reconstructions pending", "input queue length"
+and "keyframes waiting" are 0, the fusion node's "input queue length" and
+"views waiting for order" are 0, and no counter of either node changed for
+~view_idle s, it calls the fusion node's ~save service and exits; the launch
+file marks this node required, so the whole launch ends after it.
+
+All waiting uses wall (monotonic) time: with use_sim_time the /clock stops
+when the bag ends, so rospy.sleep / rospy.Timer / rospy.Time are not used
+for the idle logic.
+
+Parameters: ~depth_status, ~fusion_status (substrings of the diagnostic
+status names, default depth_node / fusion_node), ~save_service
+(/fusion_node/save), ~output (path passed to the service, "" = the fusion
+node's output_path), ~image_idle (3 s), ~view_idle (4 s), ~stale (20 s: the
+diagnostics stopped coming while everything was idle: finish too),
+~timeout (s, 0 = none; default 0)."""
 import sys
+import threading
 import time
 
 import rospy
 from diagnostic_msgs.msg import DiagnosticArray
-from sensor_msgs.msg import Image
-from wild_mvs.msg import DepthView
 from wild_mvs.srv import SaveCloud
+
+DEPTH_BUSY = ("reconstructions pending", "input queue length", "keyframes waiting")
+FUSION_BUSY = ("input queue length", "views waiting for order")
+DEPTH_COUNTERS = ("frames received", "keyframes created", "depth maps",
+                  "depth maps redone", "reconstructions failed")
+FUSION_COUNTERS = ("views received", "views fused")
+
+
+def _int(vals, key):
+    try:
+        return int(float(vals.get(key, "0")))
+    except ValueError:
+        return 0
 
 
 class Finisher:
-    def __init__(self):
-        self.first_image = None
-        self.last_image = None
-        self.last_view = time.monotonic()
-        self.busy = True
-        self.views = 0
-
-    def on_image(self, _msg):
-        now = time.monotonic()
-        if self.first_image is None:
-            self.first_image = now
-        self.last_image = now
-
-    def on_view(self, _msg):
-        self.last_view = time.monotonic()
-        self.views += 1
+    def __init__(self, depth_status, fusion_status):
+        self.depth_status = depth_status
+        self.fusion_status = fusion_status
+        self.lock = threading.Lock()
+        self.depth = None          # latest key -> int of the depth node
+        self.fusion = None         # ... and of the fusion node
+        self.first_frame = None    # monotonic time "frames received" went > 0
+        self.last_frame = None     # ... and last increased
+        self.last_change = time.monotonic()  # any counter changed
+        self.last_diag = None
 
     def on_diag(self, msg):
-        for st in msg.status:
-            if "depth_node" not in st.name:
-                continue
-            vals = {kv.key: kv.value for kv in st.values}
-            try:
-                self.busy = (int(vals.get("reconstructions pending", "0")) > 0 or
-                             int(vals.get("input queue length", "0")) > 0 or
-                             int(vals.get("keyframes waiting", "0")) > 0)
-            except ValueError:
-                pass
+        now = time.monotonic()
+        with self.lock:
+            for st in msg.status:
+                vals = {kv.key: kv.value for kv in st.values}
+                if self.depth_status in st.name and "frames received" in vals:
+                    new = {k: _int(vals, k) for k in DEPTH_COUNTERS + DEPTH_BUSY}
+                    old = self.depth or {}
+                    if new["frames received"] > old.get("frames received", 0):
+                        if self.first_frame is None:
+                            self.first_frame = now
+                        self.last_frame = now
+                    if any(new[k] != old.get(k) for k in DEPTH_COUNTERS):
+                        self.last_change = now
+                    self.depth = new
+                    self.last_diag = now
+                elif self.fusion_status in st.name and "views received" in vals:
+                    new = {k: _int(vals, k) for k in FUSION_COUNTERS + FUSION_BUSY}
+                    old = self.fusion or {}
+                    if any(new[k] != old.get(k) for k in FUSION_COUNTERS):
+                        self.last_change = now
+                    self.fusion = new
+                    self.last_diag = now
+
+    def idle(self):
+        """True while both nodes report nothing left to do."""
+        return (self.depth is not None and self.fusion is not None and
+                self.depth["frames received"] > 0 and
+                all(self.depth[k] == 0 for k in DEPTH_BUSY) and
+                all(self.fusion[k] == 0 for k in FUSION_BUSY))
+
+    def done(self, now, image_idle, view_idle, stale):
+        with self.lock:
+            if self.last_frame is None or not self.idle():
+                return False
+            if now - self.last_frame < image_idle:
+                return False
+            if now - self.last_change >= view_idle:
+                return True
+            # The diagnostics stopped while idle (e.g. a node's timers run on
+            # a /clock that stopped): nothing more will come.
+            return now - self.last_diag >= stale
 
 
 def main():
     rospy.init_node("finish_when_idle")
-    image_topic = rospy.get_param("~image", "/camera/image_raw")
-    view_topic = rospy.get_param("~views", "/depth_node/depth_view")
     service = rospy.get_param("~save_service", "/fusion_node/save")
     output = rospy.get_param("~output", "")
-    image_idle = rospy.get_param("~image_idle", 3.0)
-    view_idle = rospy.get_param("~view_idle", 4.0)
-    timeout = rospy.get_param("~timeout", 3600.0)
-    f = Finisher()
-    rospy.Subscriber(image_topic, Image, f.on_image, queue_size=50)
-    rospy.Subscriber(view_topic, DepthView, f.on_view, queue_size=50)
-    rospy.Subscriber("/diagnostics", DiagnosticArray, f.on_diag, queue_size=10)
+    image_idle = float(rospy.get_param("~image_idle", 3.0))
+    view_idle = float(rospy.get_param("~view_idle", 4.0))
+    stale = float(rospy.get_param("~stale", 20.0))
+    timeout = float(rospy.get_param("~timeout", 0.0))
+    f = Finisher(rospy.get_param("~depth_status", "depth_node"),
+                 rospy.get_param("~fusion_status", "fusion_node"))
+    rospy.Subscriber("/diagnostics", DiagnosticArray, f.on_diag, queue_size=20)
     start = time.monotonic()
+    timed_out = False
     while not rospy.is_shutdown():
         time.sleep(0.5)
         now = time.monotonic()
-        if now - start > timeout:
-            rospy.logerr("finish_when_idle: timeout after %.0f s", timeout)
+        if f.done(now, image_idle, view_idle, stale):
             break
-        if f.last_image is None or now - f.last_image < image_idle:
-            continue
-        if f.busy or now - f.last_view < view_idle:
-            continue
-        break
+        if timeout > 0 and now - start > timeout:
+            rospy.logerr("finish_when_idle: not idle after %.0f s: saving what "
+                         "was fused", timeout)
+            timed_out = True
+            break
     if rospy.is_shutdown():
         return 1
-    rospy.wait_for_service(service, timeout=30)
-    save = rospy.ServiceProxy(service, SaveCloud)
-    res = save(output)
-    played = (f.last_image - f.first_image) if f.first_image else 0.0
+    try:
+        rospy.wait_for_service(service, timeout=30)
+        res = rospy.ServiceProxy(service, SaveCloud)(output)
+    except (rospy.ROSException, rospy.ServiceException) as e:
+        rospy.logerr("finish_when_idle: %s: %s", service, e)
+        return 1
+    depth = f.depth or {}
+    fusion = f.fusion or {}
+    played = (f.last_frame - f.first_frame) if f.first_frame else 0.0
     if res.success:
-        rospy.loginfo("finish_when_idle: %d depth views, saved %d points to %s "
-                      "(%.1f s after the first image)", f.views, res.num_points,
-                      res.message, time.monotonic() - start - 0.0)
-        print("wild_mvs: saved %d points to %s; %d depth views; bag played in "
-              "%.1f s; total %.1f s" % (res.num_points, res.message, f.views,
-                                        played, time.monotonic() - (f.first_image or start)))
-        return 0
+        print("wild_mvs: saved %d points to %s; %d depth views; %d frames "
+              "received; bag played in %.1f s; total %.1f s"
+              % (res.num_points, res.message, fusion.get("views fused", 0),
+                 depth.get("frames received", 0), played,
+                 time.monotonic() - (f.first_frame or start)), flush=True)
+        return 1 if timed_out else 0
     rospy.logerr("finish_when_idle: save failed: %s", res.message)
     return 1
 
