@@ -69,6 +69,7 @@ install(FILES nodelet_plugins.xml
   DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})
 # (package.xml, the messages and the service are installed by catkin.)
 catkin_install_python(PROGRAMS src/nodes/finish_when_idle.py
+  src/nodes/pose_to_tf.py src/nodes/camera_info_publisher.py
   DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # --- tests -------------------------------------------------------------------

@@ -17,7 +17,7 @@ ROS="catkin ros-message-generation ros-message-runtime \
  libvisualization-msgs-dev ros-visualization-msgs libstd-srvs-dev ros-std-srvs \
  ros-core rosbash python3-rostest python3-rospy python3-rosbag python3-std-msgs python3-sensor-msgs \
  python3-geometry-msgs python3-std-srvs python3-diagnostic-msgs python3-numpy tf2-tools \
- python3-roslaunch pluginlib-dev libdepth-image-proc-dev"
+ python3-roslaunch pluginlib-dev libdepth-image-proc-dev python3-nav-msgs python3-tf2-ros python3-yaml"
 EXTRA="clang libclang-rt-14-dev libfuzzer-14-dev rviz xvfb xauth"
 want="$CORE"
 for a in "$@"; do

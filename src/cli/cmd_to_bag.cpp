@@ -22,7 +22,8 @@ bool IsExecutable(const std::string& path) {
 }
 
 // wild_mvs_to_bag beside this binary, or in the catkin devel space of the
-// same build folder (build/bin/wild_mvs -> build/devel/lib/wild_mvs/).
+// same build (build/bin/wild_mvs and devel/bin/wild_mvs link to
+// devel/lib/wild_mvs/wild_mvs, beside wild_mvs_to_bag).
 std::string FindToBag() {
   const std::string dir = ExecutableDir();
   if (dir.empty()) return "";
