@@ -187,7 +187,9 @@ TEST(RealBag, RecordedLikeARobot) {
   ros::WallDuration(2.0).sleep();  // let the subscriptions settle
 
   const Clock::time_point t0 = Clock::now();
-  PlayBag(bag.path, rate, "--clock").join();
+  // --delay: the subscribers connect to the newly advertised topics first
+  // (the bag is under 2 s long; its first frames would be lost otherwise).
+  PlayBag(bag.path, rate, "--clock --delay 3").join();
   const Clock::time_point bag_ended = Clock::now();
   std::printf("[real_bag] bag played in %.1f s (wall)\n",
               std::chrono::duration<double>(bag_ended - t0).count());
