@@ -40,7 +40,7 @@ has "$params" "/depth_node/world_frame: world" "$L world_frame"
 has "$params" "/depth_node/image_transport: raw" "$L transport"
 has "$params" "/depth_node/pose_source: tf" "$L pose_source"
 has "$params" "/depth_node/keyframe_min_baseline: 0.05" "$L config default (node defaults only)"
-hasnt "$params" "/depth_node/camera_frame:" "$L camera_frame default (not set)"
+has "$params" "/depth_node/camera_frame: ''" "$L camera_frame default (the image header's frame)"
 
 # A user's own bag: other topics, transport, frames, pose topic, config.
 A=(bag:=/tmp/a.bag image:=/cam0/color/image_raw transport:=compressed world_frame:=map
