@@ -89,8 +89,8 @@ inline ros::Time TimeFromNSec(uint64_t ns) {
 // What the checker needs to know about the bag written.
 struct RealWorldBag {
   std::string path;
-  std::vector<ros::Time> image_stamps;  // every image written, in order
-  std::vector<int> view_of_image;       // view index of each image
+  std::vector<ros::Time> image_stamps;         // every image written, in order
+  std::vector<int> view_of_image;              // view index of each image
   std::vector<ros::Time> first_stamp_of_view;  // first frame of each view
   std::vector<Camera> view_cameras;            // ground truth per view
   Eigen::Isometry3d body_T_camera = Eigen::Isometry3d::Identity();
@@ -252,8 +252,8 @@ inline RealWorldBag WriteRealWorldBag(const SyntheticScene& scene,
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   const uint64_t tf_step = 1000000000ULL / o.tf_rate_hz;
   const uint64_t tf_begin = start_ns - static_cast<uint64_t>(o.tf_margin_ns);
-  const uint64_t tf_end =
-      start_ns + frame_ns(num_frames - 1) + static_cast<uint64_t>(o.tf_margin_ns);
+  const uint64_t tf_end = start_ns + frame_ns(num_frames - 1) +
+                          static_cast<uint64_t>(o.tf_margin_ns);
   // /tf_static once, at the start (latched), 1 ms before the first /tf so
   // that it plays first.
   const uint64_t static_ns = tf_begin - 1000000ULL;

@@ -14,16 +14,16 @@
 // `lib/wild_mvs` folder found walking up from this executable (checking
 // each folder and its `devel/` subfolder).
 #include <gtest/gtest.h>
+#include <rosbag/view.h>
 #include <sys/wait.h>
+#include <tf2/buffer_core.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <rosbag/view.h>
 #include <set>
-#include <tf2/buffer_core.h>
 #include <sstream>
 #include <string>
 
@@ -174,8 +174,8 @@ TEST(RealWorldBag, StampsFramesAndTfGiveTheGroundTruth) {
     ASSERT_EQ(images, bag.image_stamps);
     // tf at every image stamp (interpolated) = the view's ground truth.
     for (size_t k = 0; k < images.size(); ++k) {
-      const geometry_msgs::TransformStamped T = tf.lookupTransform(
-          "world", "camera_rgb_optical_frame", images[k]);
+      const geometry_msgs::TransformStamped T =
+          tf.lookupTransform("world", "camera_rgb_optical_frame", images[k]);
       Camera cam;
       ros1::SetCameraPose(T.transform, &cam);
       const Camera& gt = bag.view_cameras[bag.view_of_image[k]];
@@ -219,8 +219,8 @@ TEST(LaunchEnds, ReconstructBagOfARealWorldBag) {
   const std::string script =
       env + "export ROS_MASTER_URI=http://localhost:" + std::to_string(port) +
       " ROS_HOSTNAME=localhost ROS_HOME=" + Quote(dir) +
-      " ROS_LOG_DIR=" + Quote(dir + "/log") +
-      "; exec timeout -k 20 " + std::to_string(limit) + " roslaunch -p " + std::to_string(port) +
+      " ROS_LOG_DIR=" + Quote(dir + "/log") + "; exec timeout -k 20 " +
+      std::to_string(limit) + " roslaunch -p " + std::to_string(port) +
       " wild_mvs reconstruct_bag.launch bag:=" + Quote(bag.path) +
       " output:=" + Quote(ply) +
       " image:=/camera/rgb/image_color camera_info:=/camera/rgb/camera_info"
