@@ -19,6 +19,15 @@ for exe in depth_node fusion_node finish_when_idle.py; do
   rosrun --prefix 'echo' wild_mvs "$exe" >"$TMP/which.log" 2>&1 </dev/null ||
     fail "rosrun wild_mvs $exe: $(cat "$TMP/which.log")"
   where=$(cat "$TMP/which.log")
+  if grep -q "non-unique" <<<"$where"; then
+    # Other build folders of this checkout (build-fuzz/, build-tsan/ from
+    # the sanitizer steps) hold copies of the Python scripts; rosrun lists
+    # them too. Accept only those besides the devel space's own.
+    others=$(grep -E '^[0-9]+\) ' <<<"$where" | sed 's/^[0-9]*) //' |
+      grep -v "^$DEVEL/lib/wild_mvs/$exe\$" | grep -v "/build-[a-z]*/" || true)
+    [ -z "$others" ] && grep -q "$DEVEL/lib/wild_mvs/$exe" <<<"$where" &&
+      where="$DEVEL/lib/wild_mvs/$exe"
+  fi
   [[ "$where" == "$DEVEL/lib/wild_mvs/$exe" ]] ||
     fail "rosrun wild_mvs $exe: expected $DEVEL/lib/wild_mvs/$exe, got: $where"
   echo "rosrun wild_mvs $exe -> $where"
