@@ -52,6 +52,8 @@ cv::Mat WrapImage(const sensor_msgs::Image& msg, int type,
                  type, const_cast<uint8_t*>(msg.data.data()), msg.step);
 }
 
+}  // namespace
+
 sensor_msgs::Image MatToMsg(const cv::Mat& m, const std::string& encoding) {
   sensor_msgs::Image msg;
   msg.height = m.rows;
@@ -65,8 +67,6 @@ sensor_msgs::Image MatToMsg(const cv::Mat& m, const std::string& encoding) {
                 msg.step);
   return msg;
 }
-
-}  // namespace
 
 void CameraFromCameraInfo(const sensor_msgs::CameraInfo& info, Camera* camera,
                           Distortion* distortion, bool rectified) {

@@ -317,17 +317,8 @@ inline RealWorldBag WriteRealWorldBag(const SyntheticScene& scene,
       cm.format = "rgb8; " + o.compression + " compressed bgr8";
       bag.write(o.image_topic + "/compressed", t, cm);
     } else {
-      sensor_msgs::Image im;
+      sensor_msgs::Image im = ros1::MatToMsg(img, o.encoding);
       im.header = info.header;
-      im.width = img.cols;
-      im.height = img.rows;
-      im.encoding = o.encoding;
-      im.is_bigendian = 0;
-      im.step = static_cast<uint32_t>(img.cols * img.elemSize());
-      im.data.resize(static_cast<size_t>(im.step) * im.height);
-      for (int r = 0; r < img.rows; ++r)
-        std::memcpy(&im.data[static_cast<size_t>(r) * im.step], img.ptr(r),
-                    im.step);
       bag.write(o.image_topic, t, im);
     }
     out.bag_end = std::max(out.bag_end, t);

@@ -100,6 +100,10 @@ cv::Mat CompressedToLinearRgb(const sensor_msgs::CompressedImage& msg,
 cv::Mat FloatImageFromMsg(const sensor_msgs::Image& msg, int channels,
                           const std::string& what);
 
+// An image message of a continuous or strided cv::Mat, rows packed
+// (step = cols * elemSize), with the given encoding; header left empty.
+sensor_msgs::Image MatToMsg(const cv::Mat& m, const std::string& encoding);
+
 // REP 118 depth image from a core depth map (0 -> NaN).
 sensor_msgs::Image DepthToMsg(const cv::Mat& depth);
 // REP 118 16-bit depth image (encoding 16UC1, millimetres rounded to the
