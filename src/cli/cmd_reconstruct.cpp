@@ -38,6 +38,11 @@ CommandSpec ReconstructSpec() {
   s.flags = {
       {"config", "FILE.yaml", "read options from a YAML file (keys as below)",
        ""},
+      {"preset", "NAME",
+       "start from a preset: default, or paper (Goesele et al. 2007 as "
+       "published: no acceptance threshold, texture guard, step control or "
+       "consistency filter)",
+       ""},
       {"dump-config", "", "print the effective options as YAML and exit", ""},
       {"views", "LIST",
        "only these reference views (comma-separated names or stems)", ""},
@@ -58,7 +63,8 @@ CommandSpec ReconstructSpec() {
        "dataset format: auto|colmap|bundler|middlebury|strecha", ""},
   };
   s.epilog =
-      "Option precedence: defaults < --config file < command-line flags.\n"
+      "Option precedence: defaults < --preset < --config file < "
+      "command-line flags.\n"
       "Example: wild_mvs reconstruct data/templeSparseRing /tmp/temple "
       "--max-image-size 320";
   return s;
@@ -75,6 +81,15 @@ int RunReconstruct(const CommandArgs& argv) {
   if (args.help()) {
     PrintCommandHelp(spec, &options, std::cout);
     return 0;
+  }
+  if (args.Has("preset")) {
+    const std::string preset = args.Get("preset");
+    if (preset == "paper") {
+      config.mvs = PaperMvsOptions();
+    } else if (preset != "default") {
+      throw UsageError(Msg("option --preset: unknown preset '", preset,
+                           "' (default, paper)"));
+    }
   }
   if (args.Has("config")) options.LoadYamlFile(args.Get("config"));
   args.ApplyCoreAssignments(&options);

@@ -184,6 +184,18 @@ void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
            "normal . (-ray) must exceed this (paper: 0.1)", -1, 1);
   set->Add("mvs.mpgc.min_active_views", &m.mpgc.min_active_views,
            "fail when fewer active views remain", 1, kIntMax);
+  set->Add("mvs.mpgc.accept_ncc", &m.mpgc.accept_ncc,
+           "accept a match only when its mean NCC reaches this; -1 = any "
+           "(paper)",
+           -1, 1);
+  set->Add("mvs.mpgc.min_texture_levels", &m.mpgc.min_texture_levels,
+           "do not match reference windows whose spread is below this many "
+           "8-bit sRGB levels; 0 = off (paper)",
+           0, 64);
+  set->Add("mvs.mpgc.normal_step_halvings", &m.mpgc.normal_step_halvings,
+           "halve a normal step that turns the patch away up to this many "
+           "times; 0 = off (paper)",
+           0, 8);
   set->Add("mvs.mpgc.optimize_normal", &m.mpgc.optimize_normal,
            "optimise the normal; false = fronto-parallel (ablation)");
   set->Add("mvs.mpgc.optimize_color_scale", &m.mpgc.optimize_color_scale,
@@ -193,9 +205,20 @@ void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
   set->Add("mvs.growing.seeds_from_neighbors", &m.growing.seeds_from_neighbors,
            "also seed from the neighbours' features projected into R");
   set->Add("mvs.growing.revisit_margin", &m.growing.revisit_margin,
-           "revisit a pixel only from a candidate whose confidence beats the "
+           "revisit a pixel only from a candidate whose mean NCC beats the "
            "stored one by more than this (paper: 0)",
-           0, 1);
+           0, 2);
+  set->Add("mvs.consistency.enabled", &m.consistency.enabled,
+           "filter each depth map against its neighbours' maps "
+           "(forward-backward reprojection); false = paper");
+  set->Add("mvs.consistency.min_consistent", &m.consistency.min_consistent,
+           "neighbour maps that must confirm a sample", 1, 32);
+  set->Add("mvs.consistency.max_reprojection_px",
+           &m.consistency.max_reprojection_px,
+           "forward-backward reprojection distance allowed, pixels", 0, 100);
+  set->Add("mvs.consistency.max_relative_depth",
+           &m.consistency.max_relative_depth,
+           "relative depth difference allowed", 0, 1);
   set->Add("mvs.sweep.step", &m.sweep.step,
            "fallback depth sweep: test every step-th pixel", 1, kIntMax);
   set->Add("mvs.sweep.num_depths", &m.sweep.num_depths,

@@ -7,12 +7,14 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <regex>
 #include <sstream>
 
 #include "wild_mvs/cli/progress.h"
 #include "wild_mvs/cli/scene_setup.h"
+#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/io/atomic_file.h"
@@ -123,6 +125,45 @@ bool ViewOutputsComplete(const std::string& out, const std::string& stem) {
          fs::is_regular_file(LogPath(out, stem), ec);
 }
 
+namespace {
+
+// Writes one view's depth map and its log (log last: the view is complete
+// once it exists). extra_json: more members for the log ("" = none).
+void WriteViewOutputs(const Scene& scene, const View& view,
+                      const std::string& dir, const DepthMap& map,
+                      const std::vector<std::string>& neighbor_names,
+                      const std::string& json_body, const std::string& extra) {
+  WriteDepthMapFiles(dir, view.Stem(), map, neighbor_names, true);
+  std::string json = json_body;
+  if (json.rfind("{\n", 0) == 0) {
+    json = "{\n  \"view\": " + JsonString(view.name) +
+           ",\n  \"stem\": " + JsonString(view.Stem()) + "," + extra +
+           json.substr(1);
+  }
+  WriteFileAtomically(LogPath(dir, view.Stem()),
+                      [&](std::ostream& os) { os << json; });
+  (void)scene;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The view log's body without the "view"/"stem" members the writer adds
+// (so that a raw log can be rewritten with more members).
+std::string StripViewHeader(const std::string& json) {
+  static const std::regex re(
+      "^\\{\\n  \"view\": \"(?:[^\"\\\\]|\\\\.)*\",\\n  \"stem\": "
+      "\"(?:[^\"\\\\]|\\\\.)*\",");
+  return std::regex_replace(json, re, "{",
+                            std::regex_constants::format_first_only);
+}
+
+}  // namespace
+
 DepthStageResult RunDepthStage(const Scene& scene,
                                const std::vector<int>& views,
                                ImageCache& images,
@@ -131,9 +172,15 @@ DepthStageResult RunDepthStage(const Scene& scene,
                                bool force, std::ostream& log) {
   const auto t0 = Clock::now();
   DepthStageResult r;
+  // With the consistency filter the MVS maps go to OUT/raw first; the
+  // filter writes the final maps to OUT.
+  const GeometricConsistencyOptions& gc = config.mvs.consistency;
+  const bool filter = gc.enabled;
+  const std::string raw = filter ? out + "/raw" : out;
   Progress progress("depth", static_cast<int>(views.size()), log,
                     StderrIsTerminal());
   const int total = static_cast<int>(views.size());
+  std::vector<int> to_filter;
   for (int k = 0; k < total; ++k) {
     const int v = views[k];
     const View& view = scene.views[v];
@@ -146,6 +193,11 @@ DepthStageResult RunDepthStage(const Scene& scene,
       progress.Skip(Msg(prefix, ": done earlier, skipped (",
                         samples >= 0 ? std::to_string(samples) : "?",
                         " samples; --force recomputes)"));
+      continue;
+    }
+    if (filter && !force && ViewOutputsComplete(raw, stem)) {
+      to_filter.push_back(v);
+      progress.Skip(Msg(prefix, ": matched earlier, to be filtered"));
       continue;
     }
     progress.Begin(stem);
@@ -167,17 +219,14 @@ DepthStageResult RunDepthStage(const Scene& scene,
         names.push_back(scene.views[n].name);
       }
     }
-    WriteDepthMapFiles(out, stem, map, names, true);
-    std::string json = report.ToJson(scene);
-    if (json.rfind("{\n", 0) == 0) {
-      json = "{\n  \"view\": " + JsonString(view.name) +
-             ",\n  \"stem\": " + JsonString(stem) + "," + json.substr(1);
-    }
-    WriteFileAtomically(LogPath(out, stem),
-                        [&](std::ostream& os) { os << json; });
+    WriteViewOutputs(scene, view, raw, map, names, report.ToJson(scene), "");
     const int valid = map.CountValid();
-    r.samples += valid;
-    ++r.computed;
+    if (filter) {
+      to_filter.push_back(v);
+    } else {
+      r.samples += valid;
+      ++r.computed;
+    }
     const double fill =
         map.empty() ? 0.0 : 100.0 * valid / (map.width() * map.height());
     std::string note =
@@ -189,7 +238,115 @@ DepthStageResult RunDepthStage(const Scene& scene,
     progress.End(note);
   }
   progress.Finish();
+  if (filter && !to_filter.empty()) {
+    FilterStageResult f =
+        FilterDepthMaps(scene, to_filter, gc, raw, out, pool, log);
+    r.computed += f.filtered;
+    r.samples += f.kept;
+    r.consistency_samples += f.samples;
+    r.consistency_kept += f.kept;
+    for (const std::string& e : f.failures) r.failures.push_back(e);
+  }
   r.seconds = SecondsSince(t0);
+  return r;
+}
+
+FilterStageResult FilterDepthMaps(const Scene& scene,
+                                  const std::vector<int>& views,
+                                  const GeometricConsistencyOptions& options,
+                                  const std::string& raw,
+                                  const std::string& out, ThreadPool* pool,
+                                  std::ostream& log) {
+  options.Check();
+  FilterStageResult r;
+  std::map<std::string, int> by_name;
+  for (size_t i = 0; i < scene.views.size(); ++i)
+    by_name[scene.views[i].name] = static_cast<int>(i);
+  const int total = static_cast<int>(views.size());
+  struct Job {
+    DepthMapFiles ref;
+    ConsistencyStats stats;
+    int neighbor_maps = 0;
+    std::string error;
+  };
+  std::vector<Job> jobs(views.size());
+  Progress progress("consistency", total, log, StderrIsTerminal());
+  // One view per task: each reads its raw map and its neighbours' (the
+  // neighbours' maps are read again by every view that needs them: a few
+  // MB each, and memory stays bounded by threads x neighbours).
+  auto run = [&](int k) {
+    Job& job = jobs[k];
+    const View& view = scene.views[views[k]];
+    try {
+      job.ref = ReadDepthMapFiles(raw, view.Stem());
+      std::vector<DepthMapFiles> nbs;
+      for (const std::string& name : job.ref.neighbor_names) {
+        auto it = by_name.find(name);
+        if (it == by_name.end()) continue;
+        const std::string stem = scene.views[it->second].Stem();
+        if (!DepthMapFilesExist(raw, stem)) continue;
+        nbs.push_back(ReadDepthMapFiles(raw, stem));
+      }
+      std::vector<const DepthMap*> ptrs;
+      for (const DepthMapFiles& n : nbs) ptrs.push_back(&n.map);
+      job.neighbor_maps = static_cast<int>(ptrs.size());
+      FilterByConsistency(&job.ref.map, ptrs, options, &job.stats);
+    } catch (const Error& e) {
+      job.error = e.what();
+    }
+  };
+  const int chunk = pool ? std::max(1, pool->size()) : 1;
+  for (int k0 = 0; k0 < total; k0 += chunk) {
+    const int n = std::min(chunk, total - k0);
+    if (pool && n > 1) {
+      pool->ParallelFor(n, [&](int i) { run(k0 + i); });
+    } else {
+      for (int i = 0; i < n; ++i) run(k0 + i);
+    }
+    // Written in order by this thread (atomic files, the log last).
+    for (int k = k0; k < k0 + n; ++k) {
+      const View& view = scene.views[views[k]];
+      Job& job = jobs[k];
+      const std::string prefix =
+          Msg("consistency ", k + 1, "/", total, " ", view.Stem());
+      progress.Begin(view.Stem());
+      if (!job.error.empty()) {
+        r.failures.push_back(Msg(view.name, ": ", job.error));
+        progress.End(Msg(prefix, ": FAILED: ", job.error));
+        continue;
+      }
+      const std::string extra =
+          Msg("\n  \"consistency\": {\"samples_before\": ", job.stats.samples,
+              ", \"kept\": ", job.stats.kept,
+              ", \"neighbor_maps\": ", job.neighbor_maps, "},");
+      WriteViewOutputs(scene, view, out, job.ref.map, job.ref.neighbor_names,
+                       StripViewHeader(ReadText(LogPath(raw, view.Stem()))),
+                       extra);
+      // The final log's "samples" is the filtered count.
+      {
+        std::string text = ReadText(LogPath(out, view.Stem()));
+        static const std::regex re("\"samples\": [0-9]+");
+        text =
+            std::regex_replace(text, re, Msg("\"samples\": ", job.stats.kept),
+                               std::regex_constants::format_first_only);
+        WriteFileAtomically(LogPath(out, view.Stem()),
+                            [&](std::ostream& os) { os << text; });
+      }
+      ++r.filtered;
+      r.samples += job.stats.samples;
+      r.kept += job.stats.kept;
+      progress.End(
+          job.neighbor_maps == 0 && job.stats.samples > 0
+              ? Msg(prefix, ": no neighbour's map in ", raw,
+                    " to check against (reconstruct its neighbours too): ",
+                    job.stats.samples, " samples kept unfiltered")
+              : Msg(prefix, ": kept ", job.stats.kept, " of ",
+                    job.stats.samples, " samples (", job.neighbor_maps,
+                    " neighbour maps)"));
+      job.ref = DepthMapFiles();
+    }
+  }
+  progress.Finish();
   return r;
 }
 

@@ -10,6 +10,19 @@
 #include "wild_mvs/core/ncc.h"
 
 namespace wild_mvs {
+namespace {
+
+// d(linear) / d(sRGB-encoded value) at linear intensity v: converts a spread
+// of linear intensities into one of encoded levels (where a camera's 8-bit
+// quantisation and noise are roughly uniform).
+double LinearPerSrgb(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  if (v <= 0.0031308) return 1.0 / 12.92;
+  // linear = ((s + 0.055) / 1.055)^2.4 -> d/ds = 2.4 / 1.055 * linear^(1.4/2.4)
+  return 2.4 / 1.055 * std::pow(v, 1.4 / 2.4);
+}
+
+}  // namespace
 
 void MpgcOptions::Check() const {
   Require(window >= 3 && window <= kMaxWindow && window % 2 == 1,
@@ -32,6 +45,14 @@ void MpgcOptions::Check() const {
           " must be >= 0");
   Require(min_facing >= 0 && min_facing < 1, "mpgc.min_facing = ", min_facing,
           " must be in [0, 1)");
+  Require(accept_ncc >= -1 && accept_ncc <= 1, "mpgc.accept_ncc = ", accept_ncc,
+          " must be in [-1, 1]");
+  Require(min_texture_levels >= 0 && min_texture_levels <= 64,
+          "mpgc.min_texture_levels = ", min_texture_levels,
+          " must be in [0, 64]");
+  Require(normal_step_halvings >= 0 && normal_step_halvings <= 8,
+          "mpgc.normal_step_halvings = ", normal_step_halvings,
+          " must be in [0, 8]");
   Require(min_active_views >= 1 && min_active_views <= kMaxActive,
           "mpgc.min_active_views = ", min_active_views, " must be in [1, ",
           kMaxActive, "]");
@@ -215,11 +236,13 @@ int PatchMatcher::FillActive() {
     PrepareView(v, slot);
     if (!SampleSlot(slot, false)) {
       state_[v] = 2;
+      Note(iteration_, MatchTrace::Kind::kRefused, v);
       continue;
     }
     const double ncc = SlotNcc(slot);
     if (local_.enabled && ncc < local_.min_ncc) {
       state_[v] = 2;
+      Note(iteration_, MatchTrace::Kind::kRefused, v);
       continue;
     }
     SlotData& sl = slots_[slot];
@@ -227,6 +250,7 @@ int PatchMatcher::FillActive() {
     sl.prev_ncc = std::numeric_limits<double>::quiet_NaN();
     InitScales(slot);
     state_[v] = 1;
+    Note(iteration_, MatchTrace::Kind::kEntered, v);
     active_[num_active_] = v;
     active_slot_[num_active_] = slot;
     ++num_active_;
@@ -270,18 +294,24 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
       }
     }
   }
+  double levels = 0;  // spread in 8-bit sRGB levels, summed over channels
   for (int c = 0; c < channels_; ++c) {
     const double mean = ref_sum_[c] / npix_;
+    double var_c = 0;
     for (int i = 0; i < npix_; ++i) {
       const double d = ref_[c * npix_ + i] - mean;
       const float df = static_cast<float>(d);
       ref_centered_[c * npix_ + i] = df;
-      var_total += d * d;
+      var_c += d * d;
       ref_saa_ += static_cast<double>(df) * df;
     }
+    var_total += var_c;
+    if (mpgc_.min_texture_levels > 0)
+      levels += std::sqrt(var_c / npix_) * 255.0 / LinearPerSrgb(mean);
   }
   // A textureless reference window cannot be matched (NCC undefined).
   if (var_total < kNccMinVariance * npix_ * channels_ * 100) return false;
+  if (levels < mpgc_.min_texture_levels * channels_) return false;
   Eigen::Vector3d n = normal;
   if (!mpgc_.optimize_normal || !(n.norm() > 0.5))
     n = Eigen::Vector3d(0, 0, -1);
@@ -315,236 +345,302 @@ double PatchMatcher::PlaneScore(int s, int t, double depth,
   return sum / k;
 }
 
-bool PatchMatcher::Match(int s, int t, double depth,
-                         const Eigen::Vector3d& normal, PatchResult* out) {
-  if (!SetupPixel(s, t, depth, normal)) return false;
-  FillActive();
-  if (num_active_ < mpgc_.min_active_views) return false;
-
-  const bool fit_normal = mpgc_.optimize_normal;
-  const bool fit_scale = mpgc_.optimize_color_scale;
-  bool changed = true;  // a new active set: full update first
-  bool converged = false;
-  int it = 0;
-  for (; it < mpgc_.max_iterations; ++it) {
-    // Sample the active views (values + derivatives) at the current patch.
-    for (int a = 0; a < num_active_;) {
-      if (!SampleSlot(active_slot_[a], true)) {
-        RemoveActive(a);
-        changed = true;
-      } else {
-        ++a;
-      }
-    }
-    if (it >= mpgc_.settle_iterations) {
-      bool dropped = false, stable = true;
-      for (int a = 0; a < num_active_;) {
-        SlotData& sl = slots_[active_slot_[a]];
-        sl.prev_ncc = sl.ncc;
-        sl.ncc = SlotNcc(active_slot_[a]);
-        const double change = std::abs(sl.ncc - sl.prev_ncc);
-        const bool moved = !(change <= mpgc_.convergence_eps);
-        if (moved) stable = false;
-        if (sl.ncc < mpgc_.drop_ncc ||
-            (it >= mpgc_.oscillation_iteration && moved)) {
-          RemoveActive(a);
-          dropped = true;
-        } else {
-          ++a;
-        }
-      }
-      if (!dropped && stable && !changed &&
-          num_active_ >= mpgc_.min_active_views) {
-        converged = true;
-        break;
-      }
-      if (dropped) {
-        changed = true;
-        if (local_.enabled) {
-          const int first_new = num_active_;
-          FillActive();
-          for (int a = first_new; a < num_active_;) {
-            if (!SampleSlot(active_slot_[a], true)) {
-              RemoveActive(a);
-            } else {
-              ++a;
-            }
-          }
-        }
-      }
-    } else if (changed && num_active_ < local_.num_active && local_.enabled) {
-      // A view left the image during settling: refill.
-      const int first_new = num_active_;
-      FillActive();
-      for (int a = first_new; a < num_active_;) {
-        if (!SampleSlot(active_slot_[a], true)) {
-          RemoveActive(a);
-        } else {
-          ++a;
-        }
-      }
-    }
-    if (num_active_ < mpgc_.min_active_views) return false;
-
-    // Linearised least squares. Residual e = I_R - c * I_V; unknowns
-    // d = (dh, dhs, dht) and dc per (view, channel); the colour scales are
-    // eliminated by the Schur complement, leaving a 3x3 (or 1x1) system.
-    const bool full = changed || (it % mpgc_.full_update_interval == 0);
-    const bool geo3 = full && fit_normal;
-    const bool scales = full && fit_scale;
-    if (!geo3 && !scales) {
-      // Depth only, scales fixed: H = sum q^2, g = sum q e (1 x 1).
-      double q2 = 0, qe = 0;
-      for (int a = 0; a < num_active_; ++a) {
-        const SlotData& sl = slots_[active_slot_[a]];
-        for (int c = 0; c < channels_; ++c) {
-          const float* val = sl.val + c * npix_;
-          const float* dv = sl.dval + c * npix_;
-          const float* rv = ref_ + c * npix_;
-          const float sc = sl.scale[c];
-          float r_q2 = 0, r_qe = 0;
-          for (int idx = 0; idx < npix_; ++idx) {
-            const float q = sc * dv[idx];
-            const float e = rv[idx] - sc * val[idx];
-            r_q2 += q * q;
-            r_qe += q * e;
-          }
-          q2 += r_q2;
-          qe += r_qe;
-        }
-      }
-      if (!(q2 > 1e-20)) return false;
-      const double dh = qe / q2;
-      if (!std::isfinite(dh)) return false;
-      h_ += dh;
-      if (!(h_ > 0) || !std::isfinite(h_)) return false;
-      changed = false;
+int PatchMatcher::SampleActive(int first) {
+  int left = 0;
+  for (int a = first; a < num_active_;) {
+    if (SampleSlot(active_slot_[a], true)) {
+      ++a;
       continue;
     }
-    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    double sii[kMaxActive][3], sie[kMaxActive][3];
-    Eigen::Vector3d sij[kMaxActive][3];
-    for (int a = 0; a < num_active_; ++a) {
-      const SlotData& sl = slots_[active_slot_[a]];
-      for (int c = 0; c < channels_; ++c) {
-        const float* val = sl.val + c * npix_;
-        const float* dv = sl.dval + c * npix_;
-        const float* rv = ref_ + c * npix_;
-        const double sc = sl.scale[c];
-        double q2 = 0, q2i = 0, q2j = 0, q2ii = 0, q2ij = 0, q2jj = 0;
-        double qe = 0, qei = 0, qej = 0, ii = 0, ie = 0, iq = 0, iqi = 0,
-               iqj = 0;
-        int idx = 0;
-        for (int j = -half_; j <= half_; ++j) {
-          double r_q2 = 0, r_q2i = 0, r_q2ii = 0, r_qe = 0, r_qei = 0, r_iq = 0,
-                 r_iqi = 0;
-          for (int i = -half_; i <= half_; ++i, ++idx) {
-            const double I = val[idx];
-            const double q = sc * dv[idx];
-            const double e = rv[idx] - sc * I;
-            const double qq = q * q;
-            r_q2 += qq;
-            r_q2i += qq * i;
-            r_q2ii += qq * i * i;
-            r_qe += q * e;
-            r_qei += q * e * i;
-            r_iq += I * q;
-            r_iqi += I * q * i;
-            ii += I * I;
-            ie += I * e;
-          }
-          q2 += r_q2;
-          q2i += r_q2i;
-          q2j += r_q2 * j;
-          q2ii += r_q2ii;
-          q2ij += r_q2i * j;
-          q2jj += r_q2 * j * j;
-          qe += r_qe;
-          qei += r_qei;
-          qej += r_qe * j;
-          iq += r_iq;
-          iqi += r_iqi;
-          iqj += r_iq * j;
-        }
-        H(0, 0) += q2;
-        H(0, 1) += q2i;
-        H(0, 2) += q2j;
-        H(1, 1) += q2ii;
-        H(1, 2) += q2ij;
-        H(2, 2) += q2jj;
-        g += Eigen::Vector3d(qe, qei, qej);
-        sii[a][c] = ii;
-        sie[a][c] = ie;
-        sij[a][c] = Eigen::Vector3d(iq, iqi, iqj);
-      }
-    }
-    H(1, 0) = H(0, 1);
-    H(2, 0) = H(0, 2);
-    H(2, 1) = H(1, 2);
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    if (scales) {
-      for (int a = 0; a < num_active_; ++a)
-        for (int c = 0; c < channels_; ++c) {
-          if (!(sii[a][c] > 1e-12)) continue;
-          H -= sij[a][c] * sij[a][c].transpose() / sii[a][c];
-          g -= sij[a][c] * (sie[a][c] / sii[a][c]);
-        }
-    }
-    if (geo3) {
-      Eigen::Matrix3d Hd = H;
-      const double damp = 1e-9 * (H.trace() + 1e-30);
-      Hd.diagonal().array() += damp;
-      Eigen::LDLT<Eigen::Matrix3d> ldlt(Hd);
-      if (ldlt.info() != Eigen::Success) return false;
-      d = ldlt.solve(g);
-    } else {
-      if (!(H(0, 0) > 1e-20)) return false;
-      d.x() = g.x() / H(0, 0);
-    }
-    if (!d.allFinite()) return false;
-    if (scales) {
-      for (int a = 0; a < num_active_; ++a) {
-        SlotData& sl = slots_[active_slot_[a]];
-        for (int c = 0; c < channels_; ++c) {
-          if (!(sii[a][c] > 1e-12)) continue;
-          const double dc = (sie[a][c] - sij[a][c].dot(d)) / sii[a][c];
-          const double nc = sl.scale[c] + dc;
-          if (nc > 1e-3 && nc < 1e3) sl.scale[c] = static_cast<float>(nc);
-        }
-      }
-    }
-    h_ += d.x();
-    if (geo3) {
-      hs_ += d.y();
-      ht_ += d.z();
-    }
-    if (!(h_ > 0) || !std::isfinite(h_)) return false;
-    changed = false;
+    Note(iteration_, MatchTrace::Kind::kLeftImage, active_[a]);
+    RemoveActive(a);
+    ++left;
   }
-  if (!converged) return false;
+  return left;
+}
 
+int PatchMatcher::TestActive(int it, bool* stable) {
+  const bool baseline = it == mpgc_.settle_iterations;
+  const bool oscillation_check =
+      mpgc_.oscillation_iteration > 0 && it == mpgc_.oscillation_iteration;
+  int dropped = 0;
+  *stable = !baseline;
+  for (int a = 0; a < num_active_;) {
+    SlotData& sl = slots_[active_slot_[a]];
+    sl.prev_ncc = baseline ? std::numeric_limits<double>::quiet_NaN() : sl.ncc;
+    sl.ncc = SlotNcc(active_slot_[a]);
+    const bool moved = !(std::abs(sl.ncc - sl.prev_ncc) <=
+                         mpgc_.convergence_eps);  // NaN (new view) = moved
+    if (baseline) Note(it, MatchTrace::Kind::kBaseline, active_[a]);
+    MatchTrace::Kind why = MatchTrace::Kind::kConverged;  // = kept
+    if (sl.ncc < mpgc_.drop_ncc) {
+      why = MatchTrace::Kind::kDropLowNcc;
+    } else if (oscillation_check && moved) {
+      why = MatchTrace::Kind::kDropOscillation;
+    }
+    if (why != MatchTrace::Kind::kConverged) {
+      Note(it, why, active_[a]);
+      RemoveActive(a);
+      ++dropped;
+      continue;
+    }
+    if (moved) *stable = false;
+    ++a;
+  }
+  return dropped;
+}
+
+int PatchMatcher::RefillActive() {
+  const int first_new = num_active_;
+  FillActive();
+  const int entered = num_active_ - first_new;
+  return entered - SampleActive(first_new);
+}
+
+// Depth only, normal and colour scales fixed: one unknown dh,
+// H = sum q^2, g = sum q e with q = c dI/dh and e = I_R - c I_V.
+bool PatchMatcher::DepthStep() {
+  double q2 = 0, qe = 0;
+  for (int a = 0; a < num_active_; ++a) {
+    const SlotData& sl = slots_[active_slot_[a]];
+    for (int c = 0; c < channels_; ++c) {
+      const float* val = sl.val + c * npix_;
+      const float* dv = sl.dval + c * npix_;
+      const float* rv = ref_ + c * npix_;
+      const float sc = sl.scale[c];
+      float r_q2 = 0, r_qe = 0;
+      for (int idx = 0; idx < npix_; ++idx) {
+        const float q = sc * dv[idx];
+        const float e = rv[idx] - sc * val[idx];
+        r_q2 += q * q;
+        r_qe += q * e;
+      }
+      q2 += r_q2;
+      qe += r_qe;
+    }
+  }
+  if (!(q2 > 1e-20)) return false;
+  const double dh = qe / q2;
+  if (!std::isfinite(dh)) return false;
+  h_ += dh;
+  return h_ > 0 && std::isfinite(h_);
+}
+
+// The linearised least squares of equation 10: residual e = I_R - c * I_V,
+// unknowns d = (dh, dhs, dht) and dc per (view, channel); the colour scales
+// are eliminated by the Schur complement, leaving a 3x3 (or 1x1) system.
+bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  double sii[kMaxActive][3], sie[kMaxActive][3];
+  Eigen::Vector3d sij[kMaxActive][3];
+  for (int a = 0; a < num_active_; ++a) {
+    const SlotData& sl = slots_[active_slot_[a]];
+    for (int c = 0; c < channels_; ++c) {
+      const float* val = sl.val + c * npix_;
+      const float* dv = sl.dval + c * npix_;
+      const float* rv = ref_ + c * npix_;
+      const double sc = sl.scale[c];
+      double q2 = 0, q2i = 0, q2j = 0, q2ii = 0, q2ij = 0, q2jj = 0;
+      double qe = 0, qei = 0, qej = 0, ii = 0, ie = 0, iq = 0, iqi = 0, iqj = 0;
+      int idx = 0;
+      for (int j = -half_; j <= half_; ++j) {
+        double r_q2 = 0, r_q2i = 0, r_q2ii = 0, r_qe = 0, r_qei = 0, r_iq = 0,
+               r_iqi = 0;
+        for (int i = -half_; i <= half_; ++i, ++idx) {
+          const double I = val[idx];
+          const double q = sc * dv[idx];
+          const double e = rv[idx] - sc * I;
+          const double qq = q * q;
+          r_q2 += qq;
+          r_q2i += qq * i;
+          r_q2ii += qq * i * i;
+          r_qe += q * e;
+          r_qei += q * e * i;
+          r_iq += I * q;
+          r_iqi += I * q * i;
+          ii += I * I;
+          ie += I * e;
+        }
+        q2 += r_q2;
+        q2i += r_q2i;
+        q2j += r_q2 * j;
+        q2ii += r_q2ii;
+        q2ij += r_q2i * j;
+        q2jj += r_q2 * j * j;
+        qe += r_qe;
+        qei += r_qei;
+        qej += r_qe * j;
+        iq += r_iq;
+        iqi += r_iqi;
+        iqj += r_iq * j;
+      }
+      H(0, 0) += q2;
+      H(0, 1) += q2i;
+      H(0, 2) += q2j;
+      H(1, 1) += q2ii;
+      H(1, 2) += q2ij;
+      H(2, 2) += q2jj;
+      g += Eigen::Vector3d(qe, qei, qej);
+      sii[a][c] = ii;
+      sie[a][c] = ie;
+      sij[a][c] = Eigen::Vector3d(iq, iqi, iqj);
+    }
+  }
+  H(1, 0) = H(0, 1);
+  H(2, 0) = H(0, 2);
+  H(2, 1) = H(1, 2);
+  if (fit_scale) {
+    for (int a = 0; a < num_active_; ++a)
+      for (int c = 0; c < channels_; ++c) {
+        if (!(sii[a][c] > 1e-12)) continue;
+        H -= sij[a][c] * sij[a][c].transpose() / sii[a][c];
+        g -= sij[a][c] * (sie[a][c] / sii[a][c]);
+      }
+  }
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  if (fit_normal) {
+    Eigen::Matrix3d Hd = H;
+    const double damp = 1e-9 * (H.trace() + 1e-30);
+    Hd.diagonal().array() += damp;
+    Eigen::LDLT<Eigen::Matrix3d> ldlt(Hd);
+    if (ldlt.info() != Eigen::Success) return false;
+    d = ldlt.solve(g);
+  } else {
+    if (!(H(0, 0) > 1e-20)) return false;
+    d.x() = g.x() / H(0, 0);
+  }
+  if (!d.allFinite()) return false;
+  if (fit_scale) {
+    for (int a = 0; a < num_active_; ++a) {
+      SlotData& sl = slots_[active_slot_[a]];
+      for (int c = 0; c < channels_; ++c) {
+        if (!(sii[a][c] > 1e-12)) continue;
+        const double dc = (sie[a][c] - sij[a][c].dot(d)) / sii[a][c];
+        const double nc = sl.scale[c] + dc;
+        if (nc > 1e-3 && nc < 1e3) sl.scale[c] = static_cast<float>(nc);
+      }
+    }
+  }
+  h_ += d.x();
+  if (!(h_ > 0) || !std::isfinite(h_)) return false;
+  if (fit_normal) {
+    // Step control: never step the normal past facing the camera.
+    double ds = d.y(), dt = d.z();
+    const Camera& cam = ctx_.ref_camera;
+    const Eigen::Vector3d ray = RayAt(cam, s_ + 0.5, t_ + 0.5);
+    for (int k = 0; k < mpgc_.normal_step_halvings; ++k) {
+      if (PatchNormal(cam, s_, t_, h_, hs_ + ds, ht_ + dt).dot(-ray) >
+          mpgc_.min_facing)
+        break;
+      ds *= 0.5;
+      dt *= 0.5;
+      if (k + 1 == mpgc_.normal_step_halvings) ds = dt = 0;
+    }
+    hs_ += ds;
+    ht_ += dt;
+  }
+  return true;
+}
+
+bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   const Camera& cam = ctx_.ref_camera;
-  const Eigen::Vector3d ray = RayAt(cam, s + 0.5, t + 0.5);
-  const Eigen::Vector3d n = PatchNormal(cam, s, t, h_, hs_, ht_);
+  const Eigen::Vector3d ray = RayAt(cam, s_ + 0.5, t_ + 0.5);
+  const Eigen::Vector3d n = PatchNormal(cam, s_, t_, h_, hs_, ht_);
   if (!(n.dot(-ray) > mpgc_.min_facing)) return false;
   double sum = 0;
   for (int a = 0; a < num_active_; ++a) sum += slots_[active_slot_[a]].ncc;
-  if (out) {
-    out->depth = h_ * ray.z();
-    out->normal = mpgc_.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);
-    out->confidence = std::clamp((sum / num_active_ + 1.0) * 0.5, 0.0, 1.0);
-    out->iterations = it + 1;
-    out->num_active = num_active_;
-    for (int a = 0; a < num_active_; ++a) {
-      const SlotData& sl = slots_[active_slot_[a]];
-      out->active[a] = active_[a];
-      out->ncc[a] = sl.ncc;
-      for (int c = 0; c < 3; ++c)
-        out->color_scale[a][c] = sl.scale[channels_ == 1 ? 0 : c];
-    }
+  const double mean_ncc = sum / num_active_;
+  if (mean_ncc < mpgc_.accept_ncc) return false;
+  if (!out) return true;
+  out->depth = h_ * ray.z();
+  out->normal = mpgc_.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);
+  out->confidence = std::clamp((mean_ncc + 1.0) * 0.5, 0.0, 1.0);
+  out->iterations = iterations;
+  out->num_active = num_active_;
+  for (int a = 0; a < num_active_; ++a) {
+    const SlotData& sl = slots_[active_slot_[a]];
+    out->active[a] = active_[a];
+    out->ncc[a] = sl.ncc;
+    for (int c = 0; c < 3; ++c)
+      out->color_scale[a][c] = sl.scale[channels_ == 1 ? 0 : c];
   }
   return true;
+}
+
+// The paper's schedule (section 6.2). Iteration k = the k-th update; the
+// tests after iteration k run at the top of loop pass `it` = k, on the
+// patch that update produced:
+//  - it < settle: no test (the system settles);
+//  - it = settle: every active view's NCC is recorded, views below kappa
+//    leave;
+//  - it > settle: views below kappa leave; converged when none left or was
+//    dropped and every NCC changed by at most eps since iteration it - 1;
+//  - it = oscillation_iteration (once): views whose NCC still moves leave;
+//  - whenever A shrank, local view selection refills it;
+//  - fail with fewer than min_active_views views or when iteration
+//    max_iterations has not converged.
+// The update of pass `it` (iteration it + 1) fits the normal and colour
+// scales when it + 1 is a multiple of full_update_interval or A changed
+// since the last full update, else the depth alone.
+bool PatchMatcher::Match(int s, int t, double depth,
+                         const Eigen::Vector3d& normal, PatchResult* out,
+                         MatchTrace* trace) {
+  trace_ = trace;
+  iteration_ = 0;
+  struct Done {  // clears the trace pointer on every return
+    MatchTrace*& t;
+    ~Done() { t = nullptr; }
+  } done{trace_};
+  if (!SetupPixel(s, t, depth, normal)) return false;
+  FillActive();
+  bool changed = true;  // a new active set: the first update is full
+  for (int it = 0;; ++it) {
+    iteration_ = it;
+    const int left = SampleActive(0);
+    int dropped = 0;
+    bool stable = false;
+    if (it >= mpgc_.settle_iterations) dropped = TestActive(it, &stable);
+    if (left + dropped == 0 && stable && !changed &&
+        num_active_ >= mpgc_.min_active_views) {
+      Note(it, MatchTrace::Kind::kConverged, -1);
+      return MakeResult(it, out);
+    }
+    if (left + dropped > 0) {
+      changed = true;
+      RefillActive();
+    }
+    if (num_active_ < mpgc_.min_active_views || it == mpgc_.max_iterations) {
+      Note(it, MatchTrace::Kind::kFailed, -1);
+      return false;
+    }
+    const bool full = changed || (it + 1) % mpgc_.full_update_interval == 0;
+    const bool fit_normal = full && mpgc_.optimize_normal;
+    const bool fit_scale = full && mpgc_.optimize_color_scale;
+    Note(it,
+         (fit_normal || fit_scale) ? MatchTrace::Kind::kFullUpdate
+                                   : MatchTrace::Kind::kDepthUpdate,
+         -1);
+    const bool ok = (fit_normal || fit_scale) ? FullStep(fit_normal, fit_scale)
+                                              : DepthStep();
+    if (!ok) {
+      Note(it, MatchTrace::Kind::kFailed, -1);
+      return false;
+    }
+    changed = false;
+  }
+}
+
+int MatchTrace::Count(Kind k) const {
+  int n = 0;
+  for (const Event& e : events) n += e.kind == k;
+  return n;
+}
+
+bool MatchTrace::Has(int iteration, Kind k) const {
+  for (const Event& e : events)
+    if (e.iteration == iteration && e.kind == k) return true;
+  return false;
 }
 
 }  // namespace wild_mvs

@@ -21,11 +21,22 @@ void MvsOptions::Check() const {
   mpgc.Check();
   growing.Check();
   sweep.Check();
+  consistency.Check();
   Require(max_image_size >= 0, "mvs.max_image_size = ", max_image_size,
           " must be >= 0 (0 = no limit)");
   Require(mpgc.min_active_views <= local.num_active,
           "mpgc.min_active_views = ", mpgc.min_active_views,
           " must not exceed local.num_active = ", local.num_active);
+}
+
+MvsOptions PaperMvsOptions() {
+  MvsOptions o;
+  o.mpgc.accept_ncc = -1;
+  o.mpgc.min_texture_levels = 0;
+  o.mpgc.normal_step_halvings = 0;
+  o.growing.revisit_margin = 0;
+  o.consistency.enabled = false;
+  return o;
 }
 
 namespace {

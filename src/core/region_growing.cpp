@@ -16,8 +16,9 @@ namespace wild_mvs {
 void RegionGrowingOptions::Check() const {
   Require(tile_size >= 8 && tile_size <= 4096,
           "growing.tile_size = ", tile_size, " must be in [8, 4096]");
-  Require(revisit_margin >= 0 && revisit_margin <= 1,
-          "growing.revisit_margin = ", revisit_margin, " must be in [0, 1]");
+  Require(revisit_margin >= 0 && revisit_margin <= 2,
+          "growing.revisit_margin = ", revisit_margin,
+          " must be in [0, 2] (NCC units)");
 }
 
 double ThreadCpuSeconds() {
@@ -184,8 +185,8 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
   const Camera& cam = context.ref_camera;
   // Whether a candidate of confidence conf may (re)visit pixel p: always
   // when p holds nothing, else only when it beats p's confidence by more
-  // than the margin.
-  const float margin = static_cast<float>(options.revisit_margin);
+  // than the margin (given in NCC units; confidence = (NCC + 1) / 2).
+  const float margin = static_cast<float>(0.5 * options.revisit_margin);
   auto worth_visit = [&](int p, float conf) {
     const float have = cmap[p];
     return !(have > 0) || (have < conf && conf - have > margin);

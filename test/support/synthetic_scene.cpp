@@ -379,6 +379,10 @@ SyntheticScene Render(const SyntheticSpec& spec) {
               spec.lighting.size() == spec.camera_centers.size(),
           "synthetic spec: lighting has ", spec.lighting.size(),
           " entries for ", spec.camera_centers.size(), " cameras");
+  Require(
+      spec.focals.empty() || spec.focals.size() == spec.camera_centers.size(),
+      "synthetic spec: focals has ", spec.focals.size(), " entries for ",
+      spec.camera_centers.size(), " cameras");
   Require(spec.noise_sigma >= 0 && spec.sparse_pixel_noise >= 0,
           "synthetic spec: noise must be >= 0");
   for (const ViewLighting& l : spec.lighting) {
@@ -399,8 +403,8 @@ SyntheticScene Render(const SyntheticSpec& spec) {
     char name[32];
     std::snprintf(name, sizeof(name), "view_%03d.png", i);
     v.name = name;
-    v.camera =
-        LookAtCamera(spec.camera_centers[i], spec.look_at, W, H, spec.focal);
+    v.camera = LookAtCamera(spec.camera_centers[i], spec.look_at, W, H,
+                            spec.focals.empty() ? spec.focal : spec.focals[i]);
     out.scene.views.push_back(v);
   }
   out.images.resize(n);
@@ -417,6 +421,9 @@ SyntheticScene Render(const SyntheticSpec& spec) {
     cv::Mat img(H, W, CV_32FC3), dep(H, W, CV_32F), nor(H, W, CV_32FC3),
         ids(H, W, CV_32S);
     const double inv_gamma = 1.0 / light.gamma;
+    const Eigen::Vector3d sun = light.sun.squaredNorm() > 0
+                                    ? Eigen::Vector3d(light.sun.normalized())
+                                    : Eigen::Vector3d::Zero();
     pool.ParallelFor(H, [&](int r) {
       std::mt19937 rng(spec.seed * 2654435761u + i * 40503u + r * 7u + 1u);
       std::normal_distribution<double> gauss(0.0, 1.0);
@@ -446,8 +453,32 @@ SyntheticScene Render(const SyntheticSpec& spec) {
             const double u = c + (sx + 0.5) / ss, v = r + (sy + 0.5) / ss;
             const Eigen::Vector3d d = RayDir(cam, u, v);
             const Hit s = Cast(objs, i, C, d);
-            if (s.object < 0) continue;
-            L += Radiance(objs[s.object], C + s.z * d, s.normal);
+            Eigen::Vector3d Ls;
+            if (s.object < 0) {
+              if (!spec.sky) continue;
+              const double elev = d.normalized().z();
+              Ls = (0.25 + 0.1 * elev) * Eigen::Vector3d(0.8, 0.9, 1.0);
+            } else if (sun.squaredNorm() > 0) {
+              const Eigen::Vector3d X = C + s.z * d;
+              Eigen::Vector3d nw = s.normal;
+              if (nw.dot(d) > 0) nw = -nw;  // the side facing the camera
+              const double ndl = nw.dot(sun);
+              double lit = 0;
+              if (ndl > 0) {
+                const Hit sh = Cast(objs, i, X + 1e-6 * nw, sun);
+                lit = sh.object < 0 ? ndl : 0.0;
+              }
+              Ls = 0.4 * (0.35 + 0.65 * lit) *
+                   Albedo(objs[s.object].obj, objs[s.object].base, X);
+            } else {
+              Ls = Radiance(objs[s.object], C + s.z * d, s.normal);
+            }
+            if (light.vignetting > 0) {
+              const double rx = (u - 0.5 * W) / (0.5 * W),
+                           ry = (v - 0.5 * H) / (0.5 * H);
+              Ls *= 1.0 - light.vignetting * 0.5 * (rx * rx + ry * ry);
+            }
+            L += Ls;
           }
         }
         L /= ss * ss;

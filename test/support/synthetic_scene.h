@@ -49,16 +49,33 @@ struct SyntheticObject {
 // i.e. 8-bit quantisation happens in the sRGB encoding, as a camera's PNG or
 // JPEG stores it, so `images` equal exactly what LoadViewImage returns for
 // the 8-bit sRGB PNGs WriteDataset writes. gamma = 1 keeps it linear.
+//
+// Two more changes, off by default:
+//  - vignetting k: L *= 1 - k * (r / r_corner)^2 before the response, r the
+//    distance of the sub-sample from the image centre;
+//  - sun (world direction towards a directional light; zero = none): the
+//    radiance of a point becomes 0.4 * albedo * (0.35 + 0.65 * max(0, n . l)
+//    * lit) with lit = 0 where another object casts a shadow (the shading
+//    and the shadows then differ between views lit from different sides,
+//    like photos taken at other times of day).
 struct ViewLighting {
   double exposure = 1.0;
   Eigen::Vector3d white_balance{1, 1, 1};
   double gamma = 1.0;
+  double vignetting = 0.0;
+  Eigen::Vector3d sun{0, 0, 0};
 };
 
 struct SyntheticSpec {
   std::vector<SyntheticObject> objects;
   int width = 320, height = 240;
   double focal = 300;  // pixels; principal point at the image centre
+  // Per-view focal lengths (empty = `focal` for all).
+  std::vector<double> focals;
+  // A sky: rays that hit nothing see radiance 0.25 + 0.1 * elevation in a
+  // blue tint, passed through each view's lighting (ground-truth depth 0
+  // there). false = black background.
+  bool sky = false;
   // Camera centres; every camera looks at `look_at`, its image x axis
   // horizontal (world z is up). See MakeRingCameras.
   std::vector<Eigen::Vector3d> camera_centers;

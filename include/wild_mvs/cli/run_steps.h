@@ -10,6 +10,7 @@
 
 #include "wild_mvs/cli/option_set.h"
 #include "wild_mvs/cli/reconstruct_config.h"
+#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/core/point_cloud.h"
 #include "wild_mvs/core/scene.h"
@@ -36,6 +37,9 @@ SparseSummary ComputeSceneTracks(Scene* scene, const ReconstructConfig& config,
 struct DepthStageResult {
   int computed = 0, skipped = 0;
   long long samples = 0;  // valid depth samples over all selected views
+  // The geometric-consistency filter of the views computed in this run:
+  // samples before and kept.
+  long long consistency_samples = 0, consistency_kept = 0;
   double seconds = 0;
   std::vector<std::string> failures;  // "view: problem"
 };
@@ -52,6 +56,23 @@ DepthStageResult RunDepthStage(const Scene& scene,
                                const ReconstructConfig& config,
                                ThreadPool* pool, const std::string& out,
                                bool force, std::ostream& log);
+
+struct FilterStageResult {
+  int filtered = 0;
+  long long samples = 0, kept = 0;
+  std::vector<std::string> failures;
+};
+// The geometric-consistency filter (GeometricConsistencyOptions) of `views`:
+// reads each view's map and its neighbours' maps from `raw` (a folder in the
+// layout of depth_map_io.h, with log/S.json), writes the filtered map and
+// its log (with a "consistency" member) to `out`. Views run in parallel on
+// `pool` (may be null); files are written in order, atomically.
+FilterStageResult FilterDepthMaps(const Scene& scene,
+                                  const std::vector<int>& views,
+                                  const GeometricConsistencyOptions& options,
+                                  const std::string& raw,
+                                  const std::string& out, ThreadPool* pool,
+                                  std::ostream& log);
 
 struct FuseResult {
   int views = 0;

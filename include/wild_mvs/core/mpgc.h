@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <vector>
 
 #include "wild_mvs/core/local_view_selection.h"
 #include "wild_mvs/core/patch.h"
@@ -20,18 +21,57 @@ struct MpgcOptions {
   double drop_ncc = 0.4;           // kappa: drop views below (paper: 0.4)
   double convergence_eps = 1e-3;   // eps on every NCC change (paper: 0.001)
   int max_iterations = 20;         // fail after (paper: 20)
-  int full_update_interval = 5;    // normal + colour scales every k-th
-                                   // iteration or on an active-set change
-                                   // (paper: 5)
-  int oscillation_iteration = 14;  // from then on drop views whose NCC
-                                   // changed by more than eps (paper: 14)
+  int full_update_interval = 5;    // normal + colour scales at every k-th
+                                   // iteration (k, 2k, ... counted from 1)
+                                   // or after a change of A (paper: 5)
+  int oscillation_iteration = 14;  // once, after this iteration, drop views
+                                   // whose NCC changed by more than eps
+                                   // (paper: 14); 0 = never
   double min_facing = 0.1;         // normal . (-ray) must exceed (paper: 0.1)
-  // (choice: the paper says "the required number of views") Fail when
-  // fewer active views remain.
+  // (choice: the paper says "the required number of views"; MVE: 4 = m)
+  // Fail when fewer active views remain.
   int min_active_views = 3;
+  // (beyond the paper; MVE's dmrecon: 0.6) Accept a converged match only
+  // when the mean NCC over A reaches this; -1 = accept any (paper).
+  double accept_ncc = -1;
+  // (beyond the paper) A reference window whose intensity spread is below
+  // this many 8-bit sRGB levels (standard deviation, mean over channels) is
+  // not matched: sky, saturated or blank walls, where NCC is noise. 0 =
+  // only the numerical floor (paper).
+  double min_texture_levels = 0;
+  // (beyond the paper) Step control: a full update that would turn the
+  // patch away from the camera (facing <= min_facing) has its normal part
+  // halved up to this many times, then dropped (depth only). 0 = off.
+  int normal_step_halvings = 0;
   bool optimize_normal = true;       // false = fronto-parallel (ablation)
   bool optimize_color_scale = true;  // false = scales fixed to 1 (lab data)
   void Check() const;
+};
+
+// What happened in one Match call, iteration by iteration (tests and
+// debugging; Match records it only when given one). `iteration` counts the
+// updates done so far: events of iteration k happen after the k-th update.
+struct MatchTrace {
+  enum class Kind {
+    kEntered,          // view entered A (local view selection)
+    kRefused,          // view tried by local view selection, not admitted
+    kLeftImage,        // view's window left its image (or behind camera)
+    kBaseline,         // NCC recorded after settling (no test yet)
+    kDropLowNcc,       // NCC < kappa
+    kDropOscillation,  // NCC changed by more than eps at the oscillation check
+    kFullUpdate,       // depth, normal and colour scales updated
+    kDepthUpdate,      // depth only
+    kConverged,
+    kFailed
+  };
+  struct Event {
+    int iteration;
+    Kind kind;
+    int view;  // index into PatchContext::views, -1 = none
+  };
+  std::vector<Event> events;
+  int Count(Kind k) const;
+  bool Has(int iteration, Kind k) const;
 };
 
 struct PatchResult {
@@ -54,10 +94,10 @@ class PatchMatcher {
 
   // Local view selection + MPGC at pixel (s, t) (integer column and row;
   // centre (s + .5, t + .5)) from depth z and camera-frame normal `normal`.
-  // True on success (converged, facing, enough views); fills *out.
+  // True on success (converged, facing, enough views, accept_ncc reached);
+  // fills *out. trace (may be null) records the schedule.
   bool Match(int s, int t, double depth, const Eigen::Vector3d& normal,
-             PatchResult* out);
-
+             PatchResult* out, MatchTrace* trace = nullptr);
   // Mean of the best `k` NCC scores over N of the window at pixel (s, t) on
   // the plane (depth, normal), without optimisation (for the depth sweep).
   // Returns -1 when fewer than k views see the window.
@@ -78,6 +118,24 @@ class PatchMatcher {
   int FreeSlot() const;
   int FillActive();
   void RemoveActive(int a);
+  // The steps of one MPGC iteration (docs/ALGORITHM.md section 4).
+  // Samples A[first..] (values + derivatives) at the current patch; views
+  // whose window left their image leave A. Returns how many left.
+  int SampleActive(int first);
+  // NCC of every active view after `it` updates: the baseline right after
+  // settling, later the kappa test, the one oscillation check and the
+  // convergence test. Returns how many views were dropped; *stable = every
+  // NCC changed by at most eps since the previous iteration.
+  int TestActive(int it, bool* stable);
+  // Refills A by local view selection after views left; returns the number
+  // that entered (sampled, with derivatives).
+  int RefillActive();
+  bool DepthStep();
+  bool FullStep(bool fit_normal, bool fit_scale);
+  bool MakeResult(int iterations, PatchResult* out) const;
+  void Note(int iteration, MatchTrace::Kind kind, int view) {
+    if (trace_) trace_->events.push_back({iteration, kind, view});
+  }
 
   const PatchContext& ctx_;
   MpgcOptions mpgc_;
@@ -99,6 +157,8 @@ class PatchMatcher {
   int active_[kMaxActive];       // view indices of A
   int active_slot_[kMaxActive];  // their scratch slots
   int num_active_ = 0;
+  MatchTrace* trace_ = nullptr;  // this call's, or null
+  int iteration_ = 0;            // updates done in this call
   struct SlotData {
     int view = -1;
     double a[kMaxWindowPixels][3];     // A_V (u, v, 1) / |K^-1 (u, v, 1)|

@@ -9,6 +9,7 @@
 
 #include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/depth_sweep.h"
+#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/global_view_selection.h"
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/core/local_view_selection.h"
@@ -27,10 +28,20 @@ struct MvsOptions {
   MpgcOptions mpgc;
   RegionGrowingOptions growing;
   DepthSweepOptions sweep;  // fallback seeding without sparse features
-  bool use_color = true;    // false = match grey images (ablation)
-  int max_image_size = 0;   // longest side of R's working image; 0 = any
+  // The filter of the finished maps against their neighbours' (run by the
+  // pipeline after every view's map exists; not by ReconstructView).
+  GeometricConsistencyOptions consistency;
+  bool use_color = true;   // false = match grey images (ablation)
+  int max_image_size = 0;  // longest side of R's working image; 0 = any
   void Check() const;
 };
+
+// The paper's pipeline with the paper's values (Goesele et al. 2007,
+// section 6 and MVE's dmrecon where the paper is silent): no acceptance
+// threshold, no texture guard or step control, revisits from any better
+// candidate, no consistency filter. `--preset paper`; the ablation tests
+// run on it.
+MvsOptions PaperMvsOptions();
 
 struct ViewReport {
   std::vector<int> neighbors;           // scene view indices (N)

@@ -1,0 +1,179 @@
+// Copyright wild_mvs authors. Writes a rendered evaluation scene with exact
+// ground truth as a dataset folder (not a test): COLMAP text model with
+// sparse points in sparse/, 8-bit sRGB PNGs in images/, ground-truth depth
+// in gt_depth/ (see testing::WriteDataset). Used by bench/run_accuracy.sh.
+//
+//   make_scene KIND OUT_DIR [--views N] [--width W] [--height H] [--seed S]
+//
+// KIND (one courtyard: a textured ground, a back wall, boxes, spheres and a
+// pillar under a sky, cameras on a 100-degree arc):
+//   constant  the same exposure, white balance and light in every view;
+//   light     per view exposure 0.35..2.6, white balance +-30 %, gamma
+//             1..2.2, vignetting up to 0.5 and a sun from another side
+//             (shading and cast shadows differ between views);
+//   clutter   constant light; every other view has its own transient
+//             occluder (a box or a sphere between camera and scene);
+//   scale     constant light; camera distances 1.6..6.0 (a 3.75x range of
+//             image scales).
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <random>
+#include <string>
+
+#include "synthetic_scene.h"
+#include "wild_mvs/core/error.h"
+
+using namespace wild_mvs;
+using testing::SyntheticObject;
+using testing::SyntheticSpec;
+using T = SyntheticObject::Type;
+
+namespace {
+
+SyntheticObject Plane(Eigen::Vector3d c, Eigen::Vector3d u, Eigen::Vector3d v,
+                      double hu, double hv, int seed, double tex) {
+  SyntheticObject o;
+  o.type = T::kPlane;
+  o.center = c;
+  o.axis_u = u;
+  o.axis_v = v;
+  o.size = Eigen::Vector3d(hu, hv, 1);
+  o.texture_seed = seed;
+  o.texture_scale = tex;
+  return o;
+}
+
+SyntheticObject Box(Eigen::Vector3d c, Eigen::Vector3d half, double yaw_deg,
+                    int seed, double tex) {
+  SyntheticObject o;
+  o.type = T::kBox;
+  o.center = c;
+  o.size = half;
+  o.rotation = Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ())
+                   .toRotationMatrix();
+  o.texture_seed = seed;
+  o.texture_scale = tex;
+  return o;
+}
+
+SyntheticObject Sphere(Eigen::Vector3d c, double r, int seed, double tex) {
+  SyntheticObject o;
+  o.type = T::kSphere;
+  o.center = c;
+  o.size = Eigen::Vector3d(r, r, r);
+  o.texture_seed = seed;
+  o.texture_scale = tex;
+  return o;
+}
+
+SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
+                        unsigned seed) {
+  SyntheticSpec s;
+  s.width = w;
+  s.height = h;
+  s.focal = 0.9 * w;
+  s.sky = true;
+  s.seed = seed;
+  s.num_sparse_points = 1500;
+  s.sparse_pixel_noise = 0.3;
+  s.supersample = 2;
+  const Eigen::Vector3d X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
+  s.objects.push_back(Plane({0, 0, 0}, X, Y, 3.0, 3.0, 11, 0.06));  // ground
+  s.objects.push_back(
+      Plane({0, 1.6, 0.9}, X, Z, 2.4, 0.9, 12, 0.08));  // back wall
+  s.objects.push_back(
+      Box({0.55, 0.35, 0.25}, {0.28, 0.22, 0.25}, 30, 21, 0.05));
+  s.objects.push_back(Box({-0.6, -0.2, 0.2}, {0.2, 0.3, 0.2}, -20, 31, 0.05));
+  s.objects.push_back(Box({-0.2, 0.9, 0.5}, {0.12, 0.12, 0.5}, 10, 32, 0.04));
+  s.objects.push_back(Sphere({-0.1, 0.5, 0.3}, 0.3, 41, 0.05));
+  s.objects.push_back(Sphere({0.9, -0.4, 0.15}, 0.15, 42, 0.04));
+  s.look_at = Eigen::Vector3d(0, 0.3, 0.35);
+
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  std::vector<double> radii(n, 3.0);
+  if (kind == "scale") {
+    for (int i = 0; i < n; ++i)  // 1.6 .. 6.0, interleaved
+      radii[i] = 1.6 * std::pow(6.0 / 1.6, ((i * 5) % n) / double(n - 1));
+  }
+  for (int i = 0; i < n; ++i) {
+    const double a = (-140 + 100.0 * i / (n - 1)) * M_PI / 180;  // arc
+    const double r = radii[i];
+    s.camera_centers.push_back(s.look_at + Eigen::Vector3d(r * std::cos(a),
+                                                           r * std::sin(a),
+                                                           0.45 * r + 0.2));
+  }
+  if (kind == "light") {
+    for (int i = 0; i < n; ++i) {
+      testing::ViewLighting l;
+      l.exposure = 0.35 * std::pow(2.6 / 0.35, U(rng));
+      l.gamma = 1.0 + 1.2 * U(rng);
+      for (int c = 0; c < 3; ++c) l.white_balance[c] = 0.7 + 0.6 * U(rng);
+      l.vignetting = 0.5 * U(rng);
+      const double az = 2 * M_PI * U(rng), el = (30 + 35 * U(rng)) * M_PI / 180;
+      l.sun = Eigen::Vector3d(std::cos(az) * std::cos(el),
+                              std::sin(az) * std::cos(el), std::sin(el));
+      s.lighting.push_back(l);
+    }
+  } else if (kind == "clutter") {
+    for (int i = 0; i < n; i += 2) {
+      const Eigen::Vector3d c = s.camera_centers[i];
+      const Eigen::Vector3d f = (s.look_at - c).normalized();
+      const Eigen::Vector3d right = f.cross(Z).normalized();
+      const double t = 0.3 + 0.3 * U(rng);
+      const Eigen::Vector3d p =
+          c + t * (s.look_at - c) + (U(rng) - 0.5) * 0.6 * right;
+      SyntheticObject o =
+          (i / 2) % 2 ? Sphere(p, 0.12 + 0.1 * U(rng), 60 + i, 0.03)
+                      : Box(p, Eigen::Vector3d(0.1, 0.1, 0.18) * (1 + U(rng)),
+                            90 * U(rng), 60 + i, 0.03);
+      o.only_in_view = i;
+      s.objects.push_back(o);
+    }
+  } else if (kind != "constant" && kind != "scale") {
+    throw Error(Msg("make_scene: unknown kind '", kind,
+                    "' (constant, light, clutter, scale)"));
+  }
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::cerr << "usage: make_scene constant|light|clutter|scale OUT_DIR "
+                 "[--views N] [--width W] [--height H] [--seed S]\n";
+    return 2;
+  }
+  try {
+    int n = 12, w = 640, h = 480;
+    unsigned seed = 5;
+    for (int i = 3; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (i + 1 >= argc) throw Error(Msg("make_scene: ", a, " needs a value"));
+      const std::string v = argv[++i];
+      if (a == "--views") {
+        n = std::stoi(v);
+      } else if (a == "--width") {
+        w = std::stoi(v);
+      } else if (a == "--height") {
+        h = std::stoi(v);
+      } else if (a == "--seed") {
+        seed = static_cast<unsigned>(std::stoul(v));
+      } else {
+        throw Error(Msg("make_scene: unknown option ", a));
+      }
+    }
+    Require(n >= 3, "make_scene: --views must be >= 3");
+    const testing::SyntheticScene s =
+        testing::Render(Courtyard(argv[1], n, w, h, seed));
+    testing::WriteDataset(s, argv[2]);
+    std::printf("%s: %d views %dx%d, %zu sparse points -> %s\n", argv[1], n, w,
+                h, s.scene.points.size(), argv[2]);
+  } catch (const std::exception& e) {
+    std::cerr << "make_scene: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

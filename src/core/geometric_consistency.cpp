@@ -1,0 +1,104 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/core/geometric_consistency.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "wild_mvs/core/error.h"
+
+namespace wild_mvs {
+
+void GeometricConsistencyOptions::Check() const {
+  Require(min_consistent >= 1 && min_consistent <= 32,
+          "consistency.min_consistent = ", min_consistent,
+          " must be in [1, 32]");
+  Require(max_reprojection_px > 0 && max_reprojection_px <= 100,
+          "consistency.max_reprojection_px = ", max_reprojection_px,
+          " must be in (0, 100]");
+  Require(max_relative_depth > 0 && max_relative_depth < 1,
+          "consistency.max_relative_depth = ", max_relative_depth,
+          " must be in (0, 1)");
+}
+
+namespace {
+
+// Whether neighbour map `nb` confirms depth z at pixel (x, y) of ref.
+bool Confirms(const Camera& rc, const DepthMap& nb, int x, int y, double z,
+              const GeometricConsistencyOptions& o) {
+  const Eigen::Vector2d p(x + 0.5, y + 0.5);
+  const Eigen::Vector3d X = rc.Backproject(p, z);
+  Eigen::Vector2d q;
+  if (!nb.camera.Project(X, &q)) return false;
+  const int qx = static_cast<int>(std::floor(q.x()));
+  const int qy = static_cast<int>(std::floor(q.y()));
+  if (qx < 0 || qy < 0 || qx >= nb.width() || qy >= nb.height()) return false;
+  const float zv = nb.depth.at<float>(qy, qx);
+  if (!(zv > 0)) return false;
+  const Eigen::Vector3d Y =
+      nb.camera.Backproject(Eigen::Vector2d(qx + 0.5, qy + 0.5), zv);
+  Eigen::Vector2d pb;
+  if (!rc.Project(Y, &pb)) return false;
+  const double zb = rc.Depth(Y);
+  return (pb - p).norm() <= o.max_reprojection_px &&
+         std::abs(zb - z) <= o.max_relative_depth * z;
+}
+
+}  // namespace
+
+cv::Mat CountConsistentViews(const DepthMap& ref,
+                             const std::vector<const DepthMap*>& neighbors,
+                             const GeometricConsistencyOptions& options) {
+  options.Check();
+  Require(!ref.empty() && ref.depth.type() == CV_32F,
+          "CountConsistentViews: empty reference depth map");
+  cv::Mat count = cv::Mat::zeros(ref.height(), ref.width(), CV_8U);
+  for (int y = 0; y < ref.height(); ++y) {
+    const float* d = ref.depth.ptr<float>(y);
+    uint8_t* c = count.ptr<uint8_t>(y);
+    for (int x = 0; x < ref.width(); ++x) {
+      if (!(d[x] > 0)) continue;
+      int n = 0;
+      for (const DepthMap* nb : neighbors)
+        if (nb && !nb->empty() &&
+            Confirms(ref.camera, *nb, x, y, d[x], options))
+          ++n;
+      c[x] = static_cast<uint8_t>(std::min(n, 255));
+    }
+  }
+  return count;
+}
+
+void FilterByConsistency(DepthMap* ref,
+                         const std::vector<const DepthMap*>& neighbors,
+                         const GeometricConsistencyOptions& options,
+                         ConsistencyStats* stats) {
+  Require(ref != nullptr, "FilterByConsistency: null map");
+  ConsistencyStats st;
+  st.samples = ref->empty() ? 0 : ref->CountValid();
+  st.kept = st.samples;
+  bool any = false;
+  for (const DepthMap* nb : neighbors) any = any || (nb && !nb->empty());
+  if (options.enabled && any && st.samples > 0) {
+    const cv::Mat count = CountConsistentViews(*ref, neighbors, options);
+    st.kept = 0;
+    for (int y = 0; y < ref->height(); ++y) {
+      const uint8_t* c = count.ptr<uint8_t>(y);
+      float* d = ref->depth.ptr<float>(y);
+      cv::Vec3f* n = ref->normal.ptr<cv::Vec3f>(y);
+      float* f = ref->confidence.ptr<float>(y);
+      for (int x = 0; x < ref->width(); ++x) {
+        if (!(d[x] > 0)) continue;
+        if (c[x] >= options.min_consistent) {
+          ++st.kept;
+          continue;
+        }
+        d[x] = 0;
+        n[x] = cv::Vec3f(0, 0, 0);
+        f[x] = 0;
+      }
+    }
+  }
+  if (stats) *stats = st;
+}
+
+}  // namespace wild_mvs

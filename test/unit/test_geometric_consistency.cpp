@@ -1,0 +1,133 @@
+// Copyright wild_mvs authors. The geometric-consistency filter
+// (docs/ALGORITHM.md section 5.3) on ground-truth depth maps of a rendered
+// scene with occlusions: true depths survive (also where some neighbours
+// are occluded and at other resolutions), corrupted ones are removed.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "synthetic_scene.h"
+#include "wild_mvs/core/geometric_consistency.h"
+
+namespace wild_mvs {
+namespace {
+
+using testing::Render;
+using testing::SyntheticScene;
+
+DepthMap GtMap(const SyntheticScene& s, int v, double scale = 1.0) {
+  DepthMap m;
+  m.view = v;
+  m.camera = s.scene.views[v].camera;
+  m.depth = s.depth[v].clone();
+  if (scale != 1.0) {
+    const Camera c = m.camera.Scaled(scale);
+    cv::resize(s.depth[v], m.depth, cv::Size(c.width, c.height), 0, 0,
+               cv::INTER_NEAREST);
+    m.camera = c;
+  }
+  m.normal = cv::Mat::zeros(m.depth.size(), CV_32FC3);
+  m.confidence = cv::Mat(m.depth.size(), CV_32F, cv::Scalar(0.9f));
+  m.confidence.setTo(0, m.depth <= 0);
+  return m;
+}
+
+const SyntheticScene& Scene8() {
+  static const SyntheticScene* s = [] {
+    testing::SyntheticSpec spec =
+        testing::ClutteredSceneSpec(false, false, 105);
+    spec.width = 200;
+    spec.height = 150;
+    spec.focal = 190;
+    spec.num_sparse_points = 10;
+    spec.supersample = 1;
+    return new SyntheticScene(Render(spec));
+  }();
+  return *s;
+}
+
+TEST(GeometricConsistency, KeepsTrueDepthsRemovesCorruptedOnes) {
+  const SyntheticScene& s = Scene8();
+  const int ref = 3;
+  DepthMap r = GtMap(s, ref);
+  std::vector<DepthMap> nbs;
+  for (int v : {1, 2, 4, 5}) nbs.push_back(GtMap(s, v, v == 5 ? 0.5 : 1.0));
+  std::vector<const DepthMap*> ptrs;
+  for (const DepthMap& m : nbs) ptrs.push_back(&m);
+  // Corrupt a block by +3 % and 500 random pixels by -10 .. +10 %.
+  cv::Mat bad = cv::Mat::zeros(r.depth.size(), CV_8U);
+  for (int y = 40; y < 70; ++y)
+    for (int x = 60; x < 100; ++x)
+      if (r.depth.at<float>(y, x) > 0) {
+        r.depth.at<float>(y, x) *= 1.03f;
+        bad.at<uint8_t>(y, x) = 1;
+      }
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> ux(0, r.width() - 1),
+      uy(0, r.height() - 1);
+  std::uniform_real_distribution<float> uf(0.02f, 0.1f);
+  for (int k = 0; k < 500; ++k) {
+    const int x = ux(rng), y = uy(rng);
+    if (!(r.depth.at<float>(y, x) > 0) || bad.at<uint8_t>(y, x)) continue;
+    r.depth.at<float>(y, x) *= 1.0f + (k % 2 ? uf(rng) : -uf(rng));
+    bad.at<uint8_t>(y, x) = 1;
+  }
+  const int valid = r.CountValid();
+  GeometricConsistencyOptions o;
+  const cv::Mat count = CountConsistentViews(r, ptrs, o);
+  ConsistencyStats st;
+  FilterByConsistency(&r, ptrs, o, &st);
+  EXPECT_EQ(st.samples, valid);
+  long good = 0, good_kept = 0, corrupt = 0, corrupt_kept = 0;
+  for (int y = 0; y < r.height(); ++y)
+    for (int x = 0; x < r.width(); ++x) {
+      if (!(s.depth[ref].at<float>(y, x) > 0)) continue;
+      const bool kept = r.depth.at<float>(y, x) > 0;
+      if (bad.at<uint8_t>(y, x)) {
+        ++corrupt;
+        corrupt_kept += kept;
+        if (!kept) {
+          EXPECT_EQ(r.confidence.at<float>(y, x), 0.f);
+        }
+      } else {
+        ++good;
+        good_kept += kept;
+        EXPECT_LE(count.at<uint8_t>(y, x), 4);
+      }
+    }
+  std::printf("true depths kept %ld / %ld, corrupted kept %ld / %ld\n",
+              good_kept, good, corrupt_kept, corrupt);
+  EXPECT_EQ(st.kept, good_kept + corrupt_kept);
+  EXPECT_GT(good_kept, 0.97 * good);
+  EXPECT_LT(corrupt_kept, 0.02 * corrupt);
+  // Two confirmations needed: fewer true depths pass (occlusions), still
+  // most of them.
+  DepthMap r2 = GtMap(s, ref);
+  o.min_consistent = 2;
+  FilterByConsistency(&r2, ptrs, o, &st);
+  EXPECT_LE(st.kept, valid);
+  EXPECT_GT(st.kept, 0.9 * valid);
+}
+
+TEST(GeometricConsistency, NoNeighboursOrDisabledKeepsEverything) {
+  const SyntheticScene& s = Scene8();
+  DepthMap r = GtMap(s, 2);
+  r.depth.at<float>(75, 100) *= 1.2f;
+  const int valid = r.CountValid();
+  ConsistencyStats st;
+  FilterByConsistency(&r, {}, GeometricConsistencyOptions(), &st);
+  EXPECT_EQ(st.kept, valid);
+  EXPECT_EQ(r.CountValid(), valid);
+  const DepthMap n = GtMap(s, 3);
+  GeometricConsistencyOptions off;
+  off.enabled = false;
+  FilterByConsistency(&r, {&n}, off, &st);
+  EXPECT_EQ(r.CountValid(), valid);
+  GeometricConsistencyOptions bad;
+  bad.max_relative_depth = 0;
+  EXPECT_THROW(bad.Check(), std::exception);
+}
+
+}  // namespace
+}  // namespace wild_mvs
