@@ -14,14 +14,17 @@
 #   whole-process CPU seconds (user + sys of `reconstruct`, /usr/bin/time)
 #     and peak RSS.
 # Usage: bench/run_accuracy.sh [--out DIR] [--kinds "constant light ..."]
-#          [--views N] [--threads N] [--skip-build] [--tag NAME]
+#          [--views N] [--points P] [--threads N] [--skip-build] [--tag NAME]
 #          [-- EXTRA reconstruct ARGS]
+# --points P: sparse points of the rendered scenes (default 1500 with exact
+# visibility); 0 = none, reconstruct computes tracks from the images first.
 # Prints one table row per scene (and writes DIR/TAG.tsv).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT=/tmp/wild_mvs_accuracy
 KINDS="constant light clutter scale"
 VIEWS=12
+POINTS=1500
 THREADS=2
 BUILD=1
 TAG=run
@@ -31,6 +34,7 @@ while [ $# -gt 0 ]; do
     --out) OUT="$2"; shift 2 ;;
     --kinds) KINDS="$2"; shift 2 ;;
     --views) VIEWS="$2"; shift 2 ;;
+    --points) POINTS="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
     --skip-build) BUILD=0; shift ;;
     --tag) TAG="$2"; shift 2 ;;
@@ -51,8 +55,9 @@ TSV="$OUT/$TAG.tsv"
 printf 'scene\tcomplete@1%%\twithin0.5%%\twithin1%%\toff>5%%\tsky\tmedian_rel\tF@1cm\tF@2cm\tF@5cm\tP@1cm\tR@1cm\tcloud_pts\tcpu_s\trss_mb\n' >"$TSV"
 for kind in $KINDS; do
   scene="$OUT/scenes/${kind}_$VIEWS"
+  [ "$POINTS" = 1500 ] || scene="${scene}_p$POINTS"
   if [ ! -f "$scene/sparse/points3D.txt" ]; then
-    "$BIN/make_scene" "$kind" "$scene" --views "$VIEWS" >&2
+    "$BIN/make_scene" "$kind" "$scene" --views "$VIEWS" --points "$POINTS" >&2
   fi
   gt="$scene/gt_cloud.ply"
   [ -f "$gt" ] || "$BIN/wild_mvs" eval make-gt-cloud --dataset "$scene" \

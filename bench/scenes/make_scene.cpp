@@ -4,6 +4,12 @@
 // in gt_depth/ (see testing::WriteDataset). Used by bench/run_accuracy.sh.
 //
 //   make_scene KIND OUT_DIR [--views N] [--width W] [--height H] [--seed S]
+//              [--points P]
+//
+// --points P: sparse points sampled on the surfaces with their exact
+// visibility (1500; 0.3 px noise); 0 = none, so that `wild_mvs reconstruct`
+// computes tracks from the images (SIFT under the scene's light changes, as
+// a user's SfM would).
 //
 // KIND (one courtyard: a textured ground, a back wall, boxes, spheres and a
 // pillar under a sky, cameras on a 100-degree arc):
@@ -11,6 +17,7 @@
 //   light     per view exposure 0.35..2.6, white balance +-30 %, gamma
 //             1..2.2, vignetting up to 0.5 and a sun from another side
 //             (shading and cast shadows differ between views);
+//   exposure, gamma, vignetting, sun: one of the changes of `light` alone;
 //   clutter   constant light; every other view has its own transient
 //             occluder (a box or a sphere between camera and scene);
 //   scale     constant light; camera distances 1.6..6.0 (a 3.75x range of
@@ -68,14 +75,14 @@ SyntheticObject Sphere(Eigen::Vector3d c, double r, int seed, double tex) {
 }
 
 SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
-                        unsigned seed) {
+                        unsigned seed, int points) {
   SyntheticSpec s;
   s.width = w;
   s.height = h;
   s.focal = 0.9 * w;
   s.sky = true;
   s.seed = seed;
-  s.num_sparse_points = 1500;
+  s.num_sparse_points = points;
   s.sparse_pixel_noise = 0.3;
   s.supersample = 2;
   const Eigen::Vector3d X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
@@ -104,16 +111,29 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
                                                            r * std::sin(a),
                                                            0.45 * r + 0.2));
   }
-  if (kind == "light") {
+  // The light kinds draw the same random values; the single-factor kinds
+  // (exposure, gamma, vignetting, sun) keep only one of the changes, to
+  // isolate what costs coverage.
+  const bool light = kind == "light" || kind == "exposure" ||
+                     kind == "gamma" || kind == "vignetting" || kind == "sun";
+  if (light) {
     for (int i = 0; i < n; ++i) {
-      testing::ViewLighting l;
-      l.exposure = 0.35 * std::pow(2.6 / 0.35, U(rng));
-      l.gamma = 1.0 + 1.2 * U(rng);
-      for (int c = 0; c < 3; ++c) l.white_balance[c] = 0.7 + 0.6 * U(rng);
-      l.vignetting = 0.5 * U(rng);
+      testing::ViewLighting l, all;
+      all.exposure = 0.35 * std::pow(2.6 / 0.35, U(rng));
+      all.gamma = 1.0 + 1.2 * U(rng);
+      for (int c = 0; c < 3; ++c) all.white_balance[c] = 0.7 + 0.6 * U(rng);
+      all.vignetting = 0.5 * U(rng);
       const double az = 2 * M_PI * U(rng), el = (30 + 35 * U(rng)) * M_PI / 180;
-      l.sun = Eigen::Vector3d(std::cos(az) * std::cos(el),
-                              std::sin(az) * std::cos(el), std::sin(el));
+      all.sun = Eigen::Vector3d(std::cos(az) * std::cos(el),
+                                std::sin(az) * std::cos(el), std::sin(el));
+      if (kind == "light") l = all;
+      if (kind == "exposure") {
+        l.exposure = all.exposure;
+        l.white_balance = all.white_balance;
+      }
+      if (kind == "gamma") l.gamma = all.gamma;
+      if (kind == "vignetting") l.vignetting = all.vignetting;
+      if (kind == "sun") l.sun = all.sun;
       s.lighting.push_back(l);
     }
   } else if (kind == "clutter") {
@@ -133,7 +153,8 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
     }
   } else if (kind != "constant" && kind != "scale") {
     throw Error(Msg("make_scene: unknown kind '", kind,
-                    "' (constant, light, clutter, scale)"));
+                    "' (constant, light, exposure, gamma, vignetting, sun, "
+                    "clutter, scale)"));
   }
   return s;
 }
@@ -142,12 +163,13 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::cerr << "usage: make_scene constant|light|clutter|scale OUT_DIR "
-                 "[--views N] [--width W] [--height H] [--seed S]\n";
+    std::cerr << "usage: make_scene constant|light|exposure|gamma|vignetting|"
+                 "sun|clutter|scale OUT_DIR "
+                 "[--views N] [--width W] [--height H] [--seed S] [--points P]\n";
     return 2;
   }
   try {
-    int n = 12, w = 640, h = 480;
+    int n = 12, w = 640, h = 480, points = 1500;
     unsigned seed = 5;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
@@ -159,6 +181,8 @@ int main(int argc, char** argv) {
         w = std::stoi(v);
       } else if (a == "--height") {
         h = std::stoi(v);
+      } else if (a == "--points") {
+        points = std::stoi(v);
       } else if (a == "--seed") {
         seed = static_cast<unsigned>(std::stoul(v));
       } else {
@@ -167,7 +191,7 @@ int main(int argc, char** argv) {
     }
     Require(n >= 3, "make_scene: --views must be >= 3");
     const testing::SyntheticScene s =
-        testing::Render(Courtyard(argv[1], n, w, h, seed));
+        testing::Render(Courtyard(argv[1], n, w, h, seed, points));
     testing::WriteDataset(s, argv[2]);
     std::printf("%s: %d views %dx%d, %zu sparse points -> %s\n", argv[1], n, w,
                 h, s.scene.points.size(), argv[2]);

@@ -196,6 +196,9 @@ void RegisterOptions(ReconstructConfig* c, OptionSet* set) {
            "halve a normal step that turns the patch away up to this many "
            "times; 0 = off (paper)",
            0, 8);
+  set->Add("mvs.mpgc.photometric_offset", &m.mpgc.photometric_offset,
+           "photometric model I_R = c I_V + b (offset per view and channel); "
+           "false = c I_V (paper)");
   set->Add("mvs.mpgc.optimize_normal", &m.mpgc.optimize_normal,
            "optimise the normal; false = fronto-parallel (ablation)");
   set->Add("mvs.mpgc.optimize_color_scale", &m.mpgc.optimize_color_scale,

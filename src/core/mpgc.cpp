@@ -206,11 +206,23 @@ void PatchMatcher::InitScales(int slot_index) {
   for (int c = 0; c < 3; ++c) sl.scale[c] = 1.0f;
   if (!mpgc_.optimize_color_scale) return;
   for (int c = 0; c < channels_; ++c) {
-    double sv = 0;
+    double sv = 0, svv = 0;
     const float* p = sl.val + c * npix_;
-    for (int i = 0; i < npix_; ++i) sv += p[i];
-    if (sv > 1e-6 && ref_sum_[c] > 1e-6)
+    for (int i = 0; i < npix_; ++i) {
+      sv += p[i];
+      svv += static_cast<double>(p[i]) * p[i];
+    }
+    if (mpgc_.photometric_offset) {
+      // Contrast ratio of the mean-free windows.
+      double saa = 0;
+      const float* r = ref_centered_ + c * npix_;
+      for (int i = 0; i < npix_; ++i) saa += static_cast<double>(r[i]) * r[i];
+      const double sbb = svv - sv * sv / npix_;
+      if (sbb > 1e-12 && saa > 1e-12)
+        sl.scale[c] = static_cast<float>(std::sqrt(saa / sbb));
+    } else if (sv > 1e-6 && ref_sum_[c] > 1e-6) {
       sl.scale[c] = static_cast<float>(ref_sum_[c] / sv);
+    }
   }
 }
 
@@ -408,15 +420,21 @@ bool PatchMatcher::DepthStep() {
       const float* dv = sl.dval + c * npix_;
       const float* rv = ref_ + c * npix_;
       const float sc = sl.scale[c];
-      float r_q2 = 0, r_qe = 0;
+      float r_q2 = 0, r_qe = 0, r_q = 0, r_e = 0;
       for (int idx = 0; idx < npix_; ++idx) {
         const float q = sc * dv[idx];
         const float e = rv[idx] - sc * val[idx];
         r_q2 += q * q;
         r_qe += q * e;
+        r_q += q;
+        r_e += e;
       }
       q2 += r_q2;
       qe += r_qe;
+      if (mpgc_.photometric_offset) {  // the offset at its optimum
+        q2 -= static_cast<double>(r_q) * r_q / npix_;
+        qe -= static_cast<double>(r_q) * r_e / npix_;
+      }
     }
   }
   if (!(q2 > 1e-20)) return false;
@@ -443,10 +461,11 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
       const double sc = sl.scale[c];
       double q2 = 0, q2i = 0, q2j = 0, q2ii = 0, q2ij = 0, q2jj = 0;
       double qe = 0, qei = 0, qej = 0, ii = 0, ie = 0, iq = 0, iqi = 0, iqj = 0;
+      double sq = 0, sqi = 0, sqj = 0, si = 0, se = 0;  // for the offset
       int idx = 0;
       for (int j = -half_; j <= half_; ++j) {
         double r_q2 = 0, r_q2i = 0, r_q2ii = 0, r_qe = 0, r_qei = 0, r_iq = 0,
-               r_iqi = 0;
+               r_iqi = 0, r_q = 0, r_qi = 0;
         for (int i = -half_; i <= half_; ++i, ++idx) {
           const double I = val[idx];
           const double q = sc * dv[idx];
@@ -461,7 +480,14 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
           r_iqi += I * q * i;
           ii += I * I;
           ie += I * e;
+          r_q += q;
+          r_qi += q * i;
+          si += I;
+          se += e;
         }
+        sq += r_q;
+        sqi += r_qi;
+        sqj += r_q * j;
         q2 += r_q2;
         q2i += r_q2i;
         q2j += r_q2 * j;
@@ -475,16 +501,30 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
         iqi += r_iqi;
         iqj += r_iq * j;
       }
-      H(0, 0) += q2;
-      H(0, 1) += q2i;
-      H(0, 2) += q2j;
-      H(1, 1) += q2ii;
-      H(1, 2) += q2ij;
-      H(2, 2) += q2jj;
-      g += Eigen::Vector3d(qe, qei, qej);
+      Eigen::Matrix3d Hc;
+      Hc << q2, q2i, q2j, q2i, q2ii, q2ij, q2j, q2ij, q2jj;
+      Eigen::Vector3d gc(qe, qei, qej), ic(iq, iqi, iqj);
+      if (mpgc_.photometric_offset) {
+        // I_R = c I_V + b: the offset b per view and channel eliminated at
+        // its optimum, i.e. every term taken about its window mean.
+        const double inv_n = 1.0 / npix_;
+        const Eigen::Vector3d m(sq * inv_n, sqi * inv_n, sqj * inv_n);
+        Hc -= npix_ * m * m.transpose();
+        gc -= m * se;
+        ic -= m * si;
+        ii -= si * si * inv_n;
+        ie -= si * se * inv_n;
+      }
+      H(0, 0) += Hc(0, 0);
+      H(0, 1) += Hc(0, 1);
+      H(0, 2) += Hc(0, 2);
+      H(1, 1) += Hc(1, 1);
+      H(1, 2) += Hc(1, 2);
+      H(2, 2) += Hc(2, 2);
+      g += gc;
       sii[a][c] = ii;
       sie[a][c] = ie;
-      sij[a][c] = Eigen::Vector3d(iq, iqi, iqj);
+      sij[a][c] = ic;
     }
   }
   H(1, 0) = H(0, 1);

@@ -43,6 +43,12 @@ struct MpgcOptions {
   // patch away from the camera (facing <= min_facing) has its normal part
   // halved up to this many times, then dropped (depth only). 0 = off.
   int normal_step_halvings = 0;
+  // (beyond the paper) Photometric model I_R = c I_V + b: a free offset b
+  // per view and channel besides the colour scale c (eliminated at its
+  // optimum: every window taken about its mean). Absorbs the local effect
+  // of gamma and tone-curve changes that a scale alone cannot. false =
+  // the paper's I_R = c I_V.
+  bool photometric_offset = false;
   bool optimize_normal = true;       // false = fronto-parallel (ablation)
   bool optimize_color_scale = true;  // false = scales fixed to 1 (lab data)
   void Check() const;
