@@ -547,4 +547,58 @@ bool PatchMatcher::Match(int s, int t, double depth,
   return true;
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MpgcOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("window"), &o->window,
+            "matching window side n of n x n (paper: 5)")
+      .Min(3)
+      .Max(kMaxWindow)
+      .Odd();
+  registry
+      ->Add(key("settle_iterations"), &o->settle_iterations,
+            "iterations before any test (paper: 5)")
+      .Min(0);
+  registry
+      ->Add(key("drop_ncc"), &o->drop_ncc,
+            "drop active views whose NCC falls below (paper: 0.4)")
+      .Min(-1)
+      .Max(1);
+  registry
+      ->Add(key("convergence_eps"), &o->convergence_eps,
+            "converged when every NCC changes less (paper: 0.001)")
+      .Above(0);
+  registry
+      ->Add(key("max_iterations"), &o->max_iterations,
+            "fail after this many iterations (paper: 20)")
+      .Note("> settle_iterations");
+  registry
+      ->Add(key("full_update_interval"), &o->full_update_interval,
+            "optimise normal and colour scales every k-th iteration "
+            "(paper: 5)")
+      .Min(1);
+  registry
+      ->Add(key("oscillation_iteration"), &o->oscillation_iteration,
+            "from this iteration drop oscillating views (paper: 14)")
+      .Min(0);
+  registry
+      ->Add(key("min_facing"), &o->min_facing,
+            "normal . (-ray) must exceed this (paper: 0.1)")
+      .Min(0)
+      .Below(1);
+  registry
+      ->Add(key("min_active_views"), &o->min_active_views,
+            "fail when fewer active views remain")
+      .Min(1)
+      .Max(kMaxActive)
+      .Note("<= local.num_active");
+  registry->Add(key("optimize_normal"), &o->optimize_normal,
+                "optimise the normal; false = fronto-parallel (ablation)");
+  registry->Add(key("optimize_color_scale"), &o->optimize_color_scale,
+                "optimise per-view colour scales; false = fixed 1 (lab data)");
+}
+
 }  // namespace wild_mvs

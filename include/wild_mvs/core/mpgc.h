@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "wild_mvs/core/local_view_selection.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/patch.h"
 
 namespace wild_mvs {
@@ -33,6 +34,9 @@ struct MpgcOptions {
   bool optimize_color_scale = true;  // false = scales fixed to 1 (lab data)
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs.mpgc".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MpgcOptions* options);
 
 struct PatchResult {
   double depth = 0;                  // z of the pixel centre

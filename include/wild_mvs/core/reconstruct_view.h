@@ -13,6 +13,7 @@
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/core/local_view_selection.h"
 #include "wild_mvs/core/mpgc.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/region_growing.h"
 #include "wild_mvs/core/rescaling.h"
 #include "wild_mvs/core/scene.h"
@@ -31,6 +32,9 @@ struct MvsOptions {
   int max_image_size = 0;   // longest side of R's working image; 0 = any
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MvsOptions* options);
 
 struct ViewReport {
   std::vector<int> neighbors;           // scene view indices (N)
