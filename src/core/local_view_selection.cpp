@@ -31,7 +31,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("num_active"), &o->num_active,
             "active views per pixel |A| (paper: 4)")
       .Min(1)
-      .Max(8);
+      .Max(8)
+      .Note(">= mpgc.min_active_views");
   registry
       ->Add(key("max_epipolar_angle_deg"), &o->max_epipolar_angle_deg,
             "epipolar-angle spread g_max in degrees (paper: 10)")

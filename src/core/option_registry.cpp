@@ -24,11 +24,18 @@ std::string Prefix(const std::string& what) {
   return what.empty() ? std::string() : what + ": ";
 }
 
+// The shortest of 10..17 significant digits that reads back exactly (so a
+// written config reloads to the same values).
 std::string FormatDouble(double v) {
   if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
-  std::ostringstream os;
-  os << std::setprecision(10) << v;
-  return os.str();
+  std::string text;
+  for (int digits = 10; digits <= 17; ++digits) {
+    std::ostringstream os;
+    os << std::setprecision(digits) << v;
+    text = os.str();
+    if (std::strtod(text.c_str(), nullptr) == v) break;
+  }
+  return text;
 }
 
 const char* Expected(OptionRegistry::Type type) {
@@ -299,6 +306,42 @@ const OptionRegistry::Option* OptionRegistry::Find(
     const std::string& key) const {
   auto it = index_.find(key);
   return it == index_.end() ? nullptr : &options_[it->second];
+}
+
+void OptionRegistry::Set(const std::string& key, const std::string& text,
+                         const std::string& where) {
+  Option* o = Find(key);
+  if (!o) {
+    // Suggest the keys of the same section to help with typos.
+    const size_t dot = key.rfind('.');
+    std::string known;
+    if (dot != std::string::npos) {
+      const std::string section = key.substr(0, dot + 1);
+      for (const Option& e : options_) {
+        if (e.key().compare(0, section.size(), section) == 0) {
+          known += (known.empty() ? "" : ", ") + e.key();
+        }
+      }
+    }
+    throw Error(Msg(where, ": unknown option '", key, "'",
+                    known.empty() ? std::string(" (see --help)")
+                                  : " (known in this section: " + known + ")"));
+  }
+  try {
+    o->SetText(text);
+  } catch (const Error& e) {
+    // "cfg.yaml line 3: mvs.x: ..." but "option --mvs.x: ..." (no repeat).
+    const bool named = where.find(key) != std::string::npos;
+    throw Error(Msg(where, ": ", named ? "" : key + ": ", e.what()));
+  }
+}
+
+bool OptionRegistry::IsSection(const std::string& section) const {
+  const std::string p = section + ".";
+  for (const Option& e : options_) {
+    if (e.key().compare(0, p.size(), p) == 0) return true;
+  }
+  return false;
 }
 
 std::string OptionRegistry::Join(const std::string& prefix,

@@ -110,6 +110,15 @@ class OptionRegistry {
   // nullptr when the key is not registered.
   Option* Find(const std::string& key);
   const Option* Find(const std::string& key) const;
+  // Sets option `key` from text (Option::SetText); `where` prefixes errors
+  // (e.g. "option --mvs.mpgc.window" or "cfg.yaml line 3"). Throws Error for
+  // an unknown key (listing the keys of its section) or a value that is not
+  // of the option's type.
+  void Set(const std::string& key, const std::string& text,
+           const std::string& where);
+  // True when some key starts with "section." (e.g. "mvs.mpgc").
+  bool IsSection(const std::string& section) const;
+
   // In registration order.
   const std::deque<Option>& options() const { return options_; }
   std::deque<Option>& options() { return options_; }
