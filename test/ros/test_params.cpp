@@ -91,7 +91,6 @@ MapParamSource ParamsFromYaml(const YAML::Node& root) {
           }
           const std::string text = kv.second.Scalar();
           const bool quoted = kv.second.Tag() == "!";
-          bool b = false;
           int i = 0;
           double d = 0;
           if (!quoted && (text == "true" || text == "false")) {
@@ -102,7 +101,6 @@ MapParamSource ParamsFromYaml(const YAML::Node& root) {
           } else if (!quoted && YAML::convert<double>::decode(kv.second, d)) {
             out.Set(key, d);
           } else {
-            (void)b;
             out.Set(key, text);
           }
         }
