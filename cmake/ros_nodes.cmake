@@ -29,6 +29,11 @@ foreach(name depth_node fusion_node wild_mvs_to_bag)
     list(APPEND WILD_MVS_ROS_EXECUTABLES ${name})
   endif()
 endforeach()
+# Writes config/{reconstruct,depth_node,fusion_node}.yaml from the option
+# registry (`wild_mvs_write_config config`; the test config_files compares).
+add_executable(wild_mvs_write_config src/tools/write_config.cpp)
+target_link_libraries(wild_mvs_write_config PRIVATE wild_mvs_ros wild_mvs_cli)
+target_compile_options(wild_mvs_write_config PRIVATE ${WILD_MVS_WARNINGS})
 if(TARGET wild_mvs_to_bag)
   # `wild_mvs to-bag` finds it beside build/bin/wild_mvs.
   add_custom_command(TARGET wild_mvs_to_bag POST_BUILD
@@ -104,6 +109,12 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
     target_compile_options(${name} PRIVATE ${WILD_MVS_WARNINGS})
     list(APPEND WILD_MVS_ROSTEST_TARGETS ${name})
   endforeach()
+  # The parameters checker compares with the CLI's reading of the files.
+  if(TARGET rostest_params)
+    target_link_libraries(rostest_params PRIVATE wild_mvs_cli)
+    target_compile_definitions(rostest_params PRIVATE
+      WILD_MVS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  endif()
   # Every launch file parses and names only nodes of packages that
   # package.xml declares (roslaunch-check; -i: `bag`, `index`, `count` have
   # no default). test/ros/test_launch_files.sh then expands them with
@@ -127,6 +138,12 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
               ${CMAKE_BINARY_DIR} ${CATKIN_DEVEL_PREFIX})
     set_tests_properties(ros_${space}_space PROPERTIES TIMEOUT 300)
   endforeach()
+  # config/*.yaml are what wild_mvs_write_config writes (the registry).
+  add_test(NAME config_files
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_config_files.sh
+            $<TARGET_FILE:wild_mvs_write_config>
+            ${CMAKE_CURRENT_SOURCE_DIR}/config)
+  set_tests_properties(config_files PROPERTIES TIMEOUT 60)
   # reconstruct_bag.launch on a bag with other topic names ends by itself.
   add_test(NAME ros_own_bag
     COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_own_bag.sh

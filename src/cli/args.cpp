@@ -151,7 +151,7 @@ void PrintCommandHelp(const CommandSpec& spec, const OptionSet* core,
     }
     os << "  -h, --help                print this help\n";
   }
-  if (core && !core->entries().empty()) {
+  if (core && !core->options().empty()) {
     os << "\nalgorithm options (also settable in the --config YAML file under "
           "the same section and key):\n";
     core->PrintHelp(os);

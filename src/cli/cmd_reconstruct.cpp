@@ -138,18 +138,18 @@ int RunReconstruct(const CommandArgs& argv) {
       previous.LoadYamlFile(RunRecordPath(out));
       std::string depth_changes;
       fusion_options_changed = mesh_options_changed = false;
-      for (size_t i = 0; i < options.entries().size(); ++i) {
-        const auto& now = options.entries()[i];
-        const auto& was = previous.entries()[i];
-        if (now.get() == was.get()) continue;
-        if (now.name.rfind("run.", 0) == 0) continue;
-        if (now.name.rfind("fusion.", 0) == 0) {
+      for (size_t i = 0; i < options.options().size(); ++i) {
+        const auto& now = options.options()[i];
+        const auto& was = previous.options()[i];
+        if (now.Text() == was.Text()) continue;
+        if (now.key().rfind("run.", 0) == 0) continue;
+        if (now.key().rfind("fusion.", 0) == 0) {
           fusion_options_changed = true;
-        } else if (now.name.rfind("meshing.", 0) == 0) {
+        } else if (now.key().rfind("meshing.", 0) == 0) {
           mesh_options_changed = true;
         } else {
           depth_changes +=
-              Msg("\n    ", now.name, ": ", was.get(), " -> ", now.get());
+              Msg("\n    ", now.key(), ": ", was.Text(), " -> ", now.Text());
         }
       }
       if (before_record.path != record.path) {

@@ -350,7 +350,7 @@ FilterStageResult FilterDepthMaps(const Scene& scene,
   return r;
 }
 
-void RegisterDatasetRecord(DatasetRecord* r, OptionSet* set) {
+void RegisterDatasetRecord(DatasetRecord* r, OptionRegistry* set) {
   set->Add("dataset.path", &r->path, "dataset folder of this run");
   set->Add("dataset.model", &r->model, "--model override (\"\" = detected)");
   set->Add("dataset.images", &r->images, "--images override (\"\" = detected)");

@@ -17,6 +17,31 @@ void DepthSweepOptions::Check() const {
           " must be in [-1, 1]");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     DepthSweepOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("step"), &o->step,
+            "fallback depth sweep: test every step-th pixel")
+      .Min(1);
+  registry
+      ->Add(key("num_depths"), &o->num_depths,
+            "fallback depth sweep: depths tested (uniform in 1/z)")
+      .Min(2);
+  registry
+      ->Add(key("num_views"), &o->num_views,
+            "fallback depth sweep: score = mean of the best k NCCs")
+      .Min(1)
+      .Max(kMaxNeighbors);
+  registry
+      ->Add(key("min_score"), &o->min_score,
+            "fallback depth sweep: seed only above this mean NCC")
+      .Min(-1)
+      .Max(1);
+}
+
 std::vector<Seed> SweepSeeds(const PatchContext& context,
                              const MpgcOptions& mpgc,
                              const LocalViewSelectionOptions& local,

@@ -31,6 +31,46 @@ void FeatureOptions::Check() const {
           " must be 0 (no limit) or >= 64");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     FeatureOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("max_features"), &o->max_features,
+            "keep at most this many SIFT features per view, 0 = no cap")
+      .Min(0);
+  registry
+      ->Add(key("contrast_threshold"), &o->contrast_threshold,
+            "SIFT contrast threshold (lower finds more on weak texture)")
+      .Above(0)
+      .Below(1);
+  registry
+      ->Add(key("edge_threshold"), &o->edge_threshold, "SIFT edge threshold")
+      .Above(0);
+  registry
+      ->Add(key("octave_layers"), &o->octave_layers, "SIFT layers per octave")
+      .Min(1)
+      .Max(10);
+  registry->Add(key("sigma"), &o->sigma, "SIFT base blur sigma")
+      .Above(0)
+      .Below(10);
+  registry
+      ->Add(key("downscale"), &o->downscale,
+            "detect features on the image shrunk by this factor")
+      .Min(1)
+      .Max(64);
+  registry
+      ->Add(key("max_image_size"), &o->max_image_size,
+            "detect features on images shrunk to this longest side, 0 = no "
+            "limit")
+      .Min(64)
+      .OrZero();
+  registry->Add(key("srgb_encode"), &o->srgb_encode,
+                "sRGB-encode the grey image before SIFT");
+  registry->Add(key("root_sift"), &o->root_sift, "use RootSIFT descriptors");
+}
+
 size_t Features::bytes() const {
   return xy.capacity() * sizeof(Eigen::Vector2f) +
          scale.capacity() * sizeof(float) +

@@ -49,6 +49,68 @@ void FusionOptions::Check() const {
           "fusion.pending_mb = ", pending_mb, " must be >= 0");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     FusionOptions* o) {
+  auto key = [&prefix](const std::string& name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("min_support"), &o->min_support,
+            "views (own included) that must agree with a sample")
+      .Min(1)
+      .Max(65535);
+  registry
+      ->Add(key("min_confidence"), &o->min_confidence,
+            "ignore samples with lower confidence")
+      .Min(0)
+      .Max(1);
+  registry
+      ->Add(key("depth_tolerance"), &o->depth_tolerance,
+            "relative depth tolerance of the consistency check")
+      .Above(0)
+      .Below(1);
+  registry
+      ->Add(key("reprojection_tolerance_px"), &o->reprojection_tolerance_px,
+            "reprojection tolerance of the consistency check (px)")
+      .Above(0);
+  registry
+      ->Add(key("normal_tolerance_deg"), &o->normal_tolerance_deg,
+            "largest angle between agreeing normals (degrees)")
+      .Above(0)
+      .Max(180);
+  registry
+      ->Add(key("cell_scale"), &o->cell_scale,
+            "merge radius as a multiple of the pixel footprint")
+      .Above(0);
+  registry
+      ->Add(key("max_neighbors"), &o->max_neighbors,
+            "related views per view at most")
+      .Min(1);
+  const char* const axes[] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    registry
+        ->Add(key(std::string("bbox_min_") + axes[k]), &o->bbox_min[k],
+              Msg("bounding box minimum ", axes[k], " (world units)"))
+        .Infinite()
+        .Note(Msg("<= bbox_max_", axes[k]));
+  }
+  for (int k = 0; k < 3; ++k) {
+    registry
+        ->Add(key(std::string("bbox_max_") + axes[k]), &o->bbox_max[k],
+              Msg("bounding box maximum ", axes[k], " (world units)"))
+        .Infinite()
+        .Note(Msg(">= bbox_min_", axes[k]));
+  }
+  registry
+      ->Add(key("map_cache_mb"), &o->map_cache_mb,
+            "budget of the depth-map cache in MB")
+      .Min(0);
+  registry
+      ->Add(key("pending_mb"), &o->pending_mb,
+            "budget of not-yet-supported samples in MB, 0 = none")
+      .Min(0);
+}
+
 // A depth map prepared for checking: filtered depth (0 = invalid), world
 // normals, confidence.
 struct StreamingFusion::Prepared {

@@ -20,6 +20,31 @@ void GeometricConsistencyOptions::Check() const {
           " must be in (0, 1)");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     GeometricConsistencyOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry->Add(key("enabled"), &o->enabled,
+                "filter each depth map against its neighbours' maps "
+                "(forward-backward reprojection); false = paper");
+  registry
+      ->Add(key("min_consistent"), &o->min_consistent,
+            "neighbour maps that must confirm a sample")
+      .Min(1)
+      .Max(32);
+  registry
+      ->Add(key("max_reprojection_px"), &o->max_reprojection_px,
+            "forward-backward reprojection distance allowed, pixels of R")
+      .Above(0)
+      .Max(100);
+  registry
+      ->Add(key("max_relative_depth"), &o->max_relative_depth,
+            "relative depth difference allowed")
+      .Above(0)
+      .Below(1);
+}
+
 namespace {
 
 // Whether neighbour map `nb` confirms depth z at pixel (x, y) of ref.

@@ -17,6 +17,22 @@ void ImageOptions::Check() const {
           " must be >= 0 (0 = no limit)");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     ImageOptions* o) {
+  registry->Add(OptionRegistry::Join(prefix, "linearize"), &o->linearize,
+                "apply the inverse sRGB curve at load (match in linear "
+                "radiance)");
+  registry
+      ->Add(OptionRegistry::Join(prefix, "cache_mb"), &o->cache_mb,
+            "image cache budget in MB (least recently used images evicted)")
+      .Above(0);
+  registry
+      ->Add(OptionRegistry::Join(prefix, "max_image_size"), &o->max_image_size,
+            "downscale images (and cameras) whose longest side exceeds this "
+            "many pixels; 0 = full size")
+      .Min(0);
+}
+
 float SrgbToLinear(float v) {
   if (v <= 0.04045f) return v / 12.92f;
   return std::pow((v + 0.055f) / 1.055f, 2.4f);

@@ -19,6 +19,32 @@ void LocalViewSelectionOptions::Check() const {
           " must be in [-1, 1]");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     LocalViewSelectionOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry->Add(key("enabled"), &o->enabled,
+                "local view selection per pixel; false = fixed best views "
+                "(ablation)");
+  registry
+      ->Add(key("num_active"), &o->num_active,
+            "active views per pixel |A| (paper: 4)")
+      .Min(1)
+      .Max(8)
+      .Note(">= mpgc.min_active_views");
+  registry
+      ->Add(key("max_epipolar_angle_deg"), &o->max_epipolar_angle_deg,
+            "epipolar-angle spread g_max in degrees (paper: 10)")
+      .Above(0)
+      .Max(90);
+  registry
+      ->Add(key("min_ncc"), &o->min_ncc,
+            "NCC needed to enter the active set (paper: 0.3)")
+      .Min(-1)
+      .Max(1);
+}
+
 Eigen::Vector2d EpipolarDirection(const Eigen::Vector3d& e, double x,
                                   double y) {
   // Line through (x, y, 1) and e: l = x cross e; its direction is (l1, -l0).

@@ -39,6 +39,52 @@ void MeshingOptions::Check() const {
           " must be in [1, 256]");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MeshingOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("depth"), &o->depth,
+            "maximum octree depth of the Poisson solve (resolution 2^depth)")
+      .Min(4)
+      .Max(14);
+  registry
+      ->Add(key("point_weight"), &o->point_weight,
+            "screening weight of the points, 0 = unscreened Poisson")
+      .Min(0);
+  registry
+      ->Add(key("samples_per_node"), &o->samples_per_node,
+            "minimum samples per octree node (more for noisy data)")
+      .Min(1);
+  registry
+      ->Add(key("scale"), &o->scale,
+            "reconstruction cube / bounding cube of the samples")
+      .Min(1)
+      .Max(4);
+  registry
+      ->Add(key("trim_distance"), &o->trim_distance,
+            "remove surface farther than this x local sample spacing from "
+            "the samples, 0 = no trimming")
+      .Min(0);
+  registry
+      ->Add(key("spacing_neighbors"), &o->spacing_neighbors,
+            "neighbours defining the local sample spacing")
+      .Min(1)
+      .Max(64);
+  registry
+      ->Add(key("min_component_faces"), &o->min_component_faces,
+            "drop connected pieces with fewer faces after trimming")
+      .Min(0);
+  registry
+      ->Add(key("decimation_cell"), &o->decimation_cell,
+            "vertex-clustering cell in world units, 0 = no decimation")
+      .Min(0);
+  registry->Add(key("threads"), &o->threads, "threads of the Poisson solver")
+      .Min(1)
+      .Max(256);
+}
+
 namespace {
 
 // Keeps the vertices with keep[i], remaps faces, drops faces that lose a

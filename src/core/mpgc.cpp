@@ -683,4 +683,80 @@ bool MatchTrace::Has(int iteration, Kind k) const {
   return false;
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MpgcOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("window"), &o->window,
+            "matching window side n of n x n (paper: 5)")
+      .Min(3)
+      .Max(kMaxWindow)
+      .Odd();
+  registry
+      ->Add(key("settle_iterations"), &o->settle_iterations,
+            "iterations before any test (paper: 5)")
+      .Min(0);
+  registry
+      ->Add(key("drop_ncc"), &o->drop_ncc,
+            "drop active views whose NCC falls below (paper: 0.4)")
+      .Min(-1)
+      .Max(1);
+  registry
+      ->Add(key("convergence_eps"), &o->convergence_eps,
+            "converged when every NCC changes less (paper: 0.001)")
+      .Above(0);
+  registry
+      ->Add(key("max_iterations"), &o->max_iterations,
+            "fail after this many iterations (paper: 20)")
+      .Note("> settle_iterations");
+  registry
+      ->Add(key("full_update_interval"), &o->full_update_interval,
+            "optimise normal and colour scales every k-th iteration "
+            "(paper: 5)")
+      .Min(1);
+  registry
+      ->Add(key("oscillation_iteration"), &o->oscillation_iteration,
+            "once, after this iteration, drop views whose NCC still moves "
+            "(paper: 14); 0 = never")
+      .Min(0);
+  registry
+      ->Add(key("min_facing"), &o->min_facing,
+            "normal . (-ray) must exceed this (paper: 0.1)")
+      .Min(0)
+      .Below(1);
+  registry
+      ->Add(key("min_active_views"), &o->min_active_views,
+            "fail when fewer active views remain")
+      .Min(1)
+      .Max(kMaxActive)
+      .Note("<= local.num_active");
+  registry
+      ->Add(key("accept_ncc"), &o->accept_ncc,
+            "accept a match only when its mean NCC reaches this; -1 = any "
+            "(paper)")
+      .Min(-1)
+      .Max(1);
+  registry
+      ->Add(key("min_texture_levels"), &o->min_texture_levels,
+            "do not match reference windows whose spread is below this many "
+            "8-bit sRGB levels; 0 = off (paper)")
+      .Min(0)
+      .Max(64);
+  registry
+      ->Add(key("normal_step_halvings"), &o->normal_step_halvings,
+            "halve a normal step that turns the patch away up to this many "
+            "times; 0 = off (paper)")
+      .Min(0)
+      .Max(8);
+  registry->Add(key("photometric_offset"), &o->photometric_offset,
+                "photometric model I_R = c I_V + b (an offset per view and "
+                "channel); false = c I_V (paper)");
+  registry->Add(key("optimize_normal"), &o->optimize_normal,
+                "optimise the normal; false = fronto-parallel (ablation)");
+  registry->Add(key("optimize_color_scale"), &o->optimize_color_scale,
+                "optimise per-view colour scales; false = fixed 1 (lab data)");
+}
+
 }  // namespace wild_mvs

@@ -286,4 +286,25 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
   return dm;
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MvsOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry->Add(key("use_color"), &o->use_color,
+                "match colour images; false = grey (ablation)");
+  registry
+      ->Add(key("max_image_size"), &o->max_image_size,
+            "longest side of the reference view's working image, 0 = any "
+            "(after image.max_image_size)")
+      .Min(0);
+  RegisterOptions(registry, key("global"), &o->global);
+  RegisterOptions(registry, key("rescaling"), &o->rescaling);
+  RegisterOptions(registry, key("local"), &o->local);
+  RegisterOptions(registry, key("mpgc"), &o->mpgc);
+  RegisterOptions(registry, key("growing"), &o->growing);
+  RegisterOptions(registry, key("sweep"), &o->sweep);
+  RegisterOptions(registry, key("consistency"), &o->consistency);
+}
+
 }  // namespace wild_mvs

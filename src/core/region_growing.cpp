@@ -279,4 +279,24 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
   }
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     RegionGrowingOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("tile_size"), &o->tile_size,
+            "region growing tile side in pixels (parallel unit)")
+      .Min(8)
+      .Max(4096);
+  registry->Add(key("seeds_from_neighbors"), &o->seeds_from_neighbors,
+                "also seed from the neighbours' features projected into R");
+  registry
+      ->Add(key("revisit_margin"), &o->revisit_margin,
+            "revisit a pixel only from a candidate whose mean NCC beats the "
+            "stored one by more than this, NCC units (paper: 0)")
+      .Min(0)
+      .Max(2);
+}
+
 }  // namespace wild_mvs

@@ -15,6 +15,25 @@ void RescalingOptions::Check() const {
   Require(max_scale >= 1, "rescaling.max_scale = ", max_scale, " must be >= 1");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     RescalingOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry->Add(key("enabled"), &o->enabled,
+                "rescale the reference and neighbours to a common scale");
+  registry
+      ->Add(key("min_scale"), &o->min_scale,
+            "downsample the reference when the coarsest neighbour's scale is "
+            "below (paper: 0.6)")
+      .Above(0)
+      .Max(1);
+  registry
+      ->Add(key("max_scale"), &o->max_scale,
+            "downsample neighbours whose scale exceeds this (paper: 1.2)")
+      .Min(1);
+}
+
 double ScaleRatio(const Scene& scene, int ref, int view,
                   const std::vector<std::vector<int>>& points_per_view,
                   const Eigen::Vector3d* fallback_point) {

@@ -53,6 +53,77 @@ void TrackerOptions::Check() const {
           "tracker.refine_iterations = ", refine_iterations, " must be >= 0");
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     TrackerOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  RegisterOptions(registry, key("features"), &o->features);
+  registry
+      ->Add(key("max_neighbors"), &o->max_neighbors,
+            "match each view against at most this many earlier views")
+      .Min(1);
+  registry
+      ->Add(key("min_overlap"), &o->min_overlap,
+            "minimum frustum overlap fraction of a candidate pair")
+      .Min(0)
+      .Max(1);
+  registry
+      ->Add(key("max_pair_angle_deg"), &o->max_pair_angle_deg,
+            "do not match pairs whose optical axes differ by more (degrees)")
+      .Above(0)
+      .Max(180);
+  registry
+      ->Add(key("scene_depth"), &o->scene_depth,
+            "typical scene depth for the overlap test, 0 = automatic")
+      .Min(0);
+  registry
+      ->Add(key("max_epipolar_distance"), &o->max_epipolar_distance,
+            "accept matches within this distance of the epipolar line (px)")
+      .Above(0);
+  registry->Add(key("ratio"), &o->ratio, "Lowe's ratio test threshold")
+      .Above(0)
+      .Max(1);
+  registry
+      ->Add(key("max_descriptor_distance"), &o->max_descriptor_distance,
+            "bound on the L2 distance of unit-normalised descriptors")
+      .Above(0)
+      .Max(2);
+  registry->Add(key("mutual"), &o->mutual,
+                "keep a match only when best in both directions");
+  registry
+      ->Add(key("max_reprojection_error"), &o->max_reprojection_error,
+            "remove observations reprojecting farther (px)")
+      .Above(0);
+  registry
+      ->Add(key("max_outlier_removals"), &o->max_outlier_removals,
+            "at most this many observations removed per track")
+      .Min(0);
+  registry
+      ->Add(key("min_triangulation_angle_deg"), &o->min_triangulation_angle_deg,
+            "a point's largest pairwise viewing angle must reach this (deg)")
+      .Min(0)
+      .Below(90);
+  registry
+      ->Add(key("max_scale_ratio"), &o->max_scale_ratio,
+            "feature scales of a track may differ by at most this factor, "
+            "0 = off")
+      .Min(1)
+      .OrZero();
+  registry->Add(key("resolve_conflicts"), &o->resolve_conflicts,
+                "keep the best feature of a view with two in one track (else "
+                "reject the track)");
+  registry
+      ->Add(key("min_track_length"), &o->min_track_length,
+            "tracks seen in fewer views produce no point")
+      .Min(2);
+  registry
+      ->Add(key("refine_iterations"), &o->refine_iterations,
+            "Gauss-Newton iterations of the triangulation refinement")
+      .Min(0);
+  // `compact` is a test switch (the results are the same), not an option.
+}
+
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;

@@ -1,10 +1,8 @@
-// Copyright wild_mvs authors. Parameter name -> option field, in one table
-// per node. The names are documented in config/*.yaml.
+// Copyright wild_mvs authors. ROS parameters <-> option structs through the
+// option registry; the nodes' options register their fields here.
 #include "wild_mvs/ros/params.h"
 
-#include <algorithm>
 #include <cmath>
-#include <functional>
 #include <set>
 
 #include "wild_mvs/core/error.h"
@@ -13,19 +11,6 @@ namespace wild_mvs {
 namespace ros1 {
 
 namespace {
-
-const char* TypeName(const ParamSource::Value& v) {
-  switch (v.index()) {
-    case 0:
-      return "bool";
-    case 1:
-      return "int";
-    case 2:
-      return "double";
-    default:
-      return "string";
-  }
-}
 
 std::string Describe(const ParamSource::Value& v) {
   return std::visit(
@@ -37,143 +22,23 @@ std::string Describe(const ParamSource::Value& v) {
       v);
 }
 
-// A table of (name, field) bindings; Apply reads every bound parameter.
-class Binder {
- public:
-  explicit Binder(const ParamSource& src) : src_(src) {}
-  template <typename T>
-  void Bind(const std::string& name, T* field) {
-    names_.push_back(name);
-    src_.Get(name, field);
-    values_[name] = ParamSource::Value(*field);
+void SetValue(const ParamSource::Value& v, OptionRegistry::Option* o) {
+  if (auto* b = std::get_if<bool>(&v)) {
+    o->SetBool(*b);
+  } else if (auto* i = std::get_if<int>(&v)) {
+    o->SetInt(*i);
+  } else if (auto* d = std::get_if<double>(&v)) {
+    o->SetDouble(*d);
+  } else {
+    const std::string& s = std::get<std::string>(v);
+    // rosparam's YAML reads "inf" as a string; accept it where infinity is a
+    // value (an open bounding box).
+    if (o->type() == OptionRegistry::Type::kDouble && o->allow_infinite()) {
+      o->SetText(s);
+    } else {
+      o->SetString(s);
+    }
   }
-  const std::vector<std::string>& names() const { return names_; }
-  // Every bound parameter's value after reading (the default when unset).
-  const std::map<std::string, ParamSource::Value>& values() const {
-    return values_;
-  }
-
- private:
-  const ParamSource& src_;
-  std::vector<std::string> names_;
-  std::map<std::string, ParamSource::Value> values_;
-};
-
-void BindMvs(Binder& b, MvsOptions* m) {
-  b.Bind("mvs/num_neighbors", &m->global.num_neighbors);
-  b.Bind("mvs/max_parallax_deg", &m->global.max_parallax_deg);
-  b.Bind("mvs/min_baseline_deg", &m->global.min_baseline_deg);
-  b.Bind("mvs/rescaling", &m->rescaling.enabled);
-  b.Bind("mvs/min_scale", &m->rescaling.min_scale);
-  b.Bind("mvs/max_scale", &m->rescaling.max_scale);
-  b.Bind("mvs/local_view_selection", &m->local.enabled);
-  b.Bind("mvs/num_active", &m->local.num_active);
-  b.Bind("mvs/max_epipolar_angle_deg", &m->local.max_epipolar_angle_deg);
-  b.Bind("mvs/min_ncc", &m->local.min_ncc);
-  b.Bind("mvs/window", &m->mpgc.window);
-  b.Bind("mvs/drop_ncc", &m->mpgc.drop_ncc);
-  b.Bind("mvs/convergence_eps", &m->mpgc.convergence_eps);
-  b.Bind("mvs/max_iterations", &m->mpgc.max_iterations);
-  b.Bind("mvs/min_facing", &m->mpgc.min_facing);
-  b.Bind("mvs/min_active_views", &m->mpgc.min_active_views);
-  b.Bind("mvs/optimize_normal", &m->mpgc.optimize_normal);
-  b.Bind("mvs/optimize_color_scale", &m->mpgc.optimize_color_scale);
-  b.Bind("mvs/tile_size", &m->growing.tile_size);
-  b.Bind("mvs/seeds_from_neighbors", &m->growing.seeds_from_neighbors);
-  b.Bind("mvs/revisit_margin", &m->growing.revisit_margin);
-  b.Bind("mvs/sweep_step", &m->sweep.step);
-  b.Bind("mvs/sweep_num_depths", &m->sweep.num_depths);
-  b.Bind("mvs/use_color", &m->use_color);
-  b.Bind("mvs/max_image_size", &m->max_image_size);
-}
-
-void BindTracker(Binder& b, TrackerOptions* t) {
-  b.Bind("tracker/max_features", &t->features.max_features);
-  b.Bind("tracker/feature_downscale", &t->features.downscale);
-  b.Bind("tracker/max_neighbors", &t->max_neighbors);
-  b.Bind("tracker/min_overlap", &t->min_overlap);
-  b.Bind("tracker/scene_depth", &t->scene_depth);
-  b.Bind("tracker/max_epipolar_distance", &t->max_epipolar_distance);
-  b.Bind("tracker/ratio", &t->ratio);
-  b.Bind("tracker/max_reprojection_error", &t->max_reprojection_error);
-  b.Bind("tracker/min_triangulation_angle_deg",
-         &t->min_triangulation_angle_deg);
-}
-
-void BindFusion(Binder& b, FusionOptions* f) {
-  b.Bind("fusion/min_support", &f->min_support);
-  b.Bind("fusion/min_confidence", &f->min_confidence);
-  b.Bind("fusion/depth_tolerance", &f->depth_tolerance);
-  b.Bind("fusion/reprojection_tolerance_px", &f->reprojection_tolerance_px);
-  b.Bind("fusion/normal_tolerance_deg", &f->normal_tolerance_deg);
-  b.Bind("fusion/cell_scale", &f->cell_scale);
-  b.Bind("fusion/max_neighbors", &f->max_neighbors);
-  b.Bind("fusion/map_cache_mb", &f->map_cache_mb);
-  b.Bind("fusion/pending_mb", &f->pending_mb);
-}
-
-std::vector<std::string> BindDepth(Binder& b, DepthNodeOptions* o) {
-  b.Bind("world_frame", &o->world_frame);
-  b.Bind("pose_source", &o->pose_source);
-  b.Bind("tf_timeout", &o->tf_timeout);
-  b.Bind("pose_sync_tolerance", &o->pose_sync_tolerance);
-  b.Bind("camera_frame", &o->camera_frame);
-  b.Bind("image_transport", &o->image_transport);
-  b.Bind("camera_info_latest", &o->camera_info_latest);
-  b.Bind("rectified", &o->rectified);
-  b.Bind("depth_encoding", &o->depth_encoding);
-  b.Bind("sparse_source", &o->sparse_source);
-  b.Bind("input_queue_size", &o->input_queue_size);
-  b.Bind("diagnostics_period", &o->diagnostics_period);
-  b.Bind("error_throttle", &o->error_throttle);
-  b.Bind("linearize", &o->linearize);
-  StreamOptions& s = o->stream;
-  b.Bind("keyframe_min_baseline", &s.keyframes.min_baseline);
-  b.Bind("keyframe_min_angle_deg", &s.keyframes.min_angle_deg);
-  b.Bind("max_keyframes", &s.store.max_keyframes);
-  b.Bind("max_keyframe_mb", &s.store.max_mb);
-  b.Bind("num_threads", &s.num_threads);
-  b.Bind("max_pending", &s.max_pending);
-  b.Bind("worker_index", &s.worker_index);
-  b.Bind("worker_count", &s.worker_count);
-  b.Bind("min_neighbors", &s.min_neighbors);
-  b.Bind("lookahead", &s.lookahead);
-  b.Bind("idle_flush", &s.idle_flush);
-  b.Bind("redo_min_gain", &s.redo_min_gain);
-  b.Bind("max_redo", &s.max_redo);
-  b.Bind("max_image_size", &s.max_image_size);
-  b.Bind("max_pose_jump", &s.max_pose_jump);
-  b.Bind("stamp_reset_threshold", &s.stamp_reset_threshold);
-  BindMvs(b, &s.mvs);
-  BindTracker(b, &s.tracker);
-  s.use_tracker = o->sparse_source == "tracker";
-  return b.names();
-}
-
-std::vector<std::string> BindFusionNode(Binder& b, FusionNodeOptions* o) {
-  b.Bind("world_frame", &o->world_frame);
-  b.Bind("publish_period", &o->publish_period);
-  b.Bind("mesh_period", &o->mesh_period);
-  b.Bind("output_path", &o->output_path);
-  b.Bind("input_queue_size", &o->input_queue_size);
-  b.Bind("diagnostics_period", &o->diagnostics_period);
-  b.Bind("error_throttle", &o->error_throttle);
-  b.Bind("max_published_points", &o->max_published_points);
-  b.Bind("reorder_timeout", &o->reorder_timeout);
-  b.Bind("on_new_session", &o->on_new_session);
-  b.Bind("map_store_mb", &o->map_store_mb);
-  b.Bind("spill_dir", &o->spill_dir);
-  BindFusion(b, &o->fusion);
-  return b.names();
-}
-
-std::vector<std::string> Unknown(const ParamSource& params,
-                                 const std::vector<std::string>& known) {
-  const std::set<std::string> k(known.begin(), known.end());
-  std::vector<std::string> out;
-  for (const std::string& n : params.Names())
-    if (!k.count(n)) out.push_back(n);
-  return out;
 }
 
 // Runs Check() and prefixes the error with where the parameters come from.
@@ -188,60 +53,6 @@ void CheckOptions(const T& options, const ParamSource& params) {
 
 }  // namespace
 
-void ParamSource::Get(const std::string& name, bool* v) const {
-  Value x;
-  if (!Lookup(name, &x)) return;
-  if (auto* b = std::get_if<bool>(&x)) {
-    *v = *b;
-    return;
-  }
-  throw Error(Msg(Where(), "/", name, " = ", Describe(x), " is a ", TypeName(x),
-                  ", expected a bool"));
-}
-
-void ParamSource::Get(const std::string& name, int* v) const {
-  Value x;
-  if (!Lookup(name, &x)) return;
-  if (auto* i = std::get_if<int>(&x)) {
-    *v = *i;
-    return;
-  }
-  if (auto* d = std::get_if<double>(&x)) {
-    if (std::isfinite(*d) && *d == std::round(*d) && std::abs(*d) < 2e9) {
-      *v = static_cast<int>(*d);
-      return;
-    }
-  }
-  throw Error(Msg(Where(), "/", name, " = ", Describe(x), " is a ", TypeName(x),
-                  ", expected an integer"));
-}
-
-void ParamSource::Get(const std::string& name, double* v) const {
-  Value x;
-  if (!Lookup(name, &x)) return;
-  if (auto* d = std::get_if<double>(&x)) {
-    *v = *d;
-    return;
-  }
-  if (auto* i = std::get_if<int>(&x)) {
-    *v = *i;
-    return;
-  }
-  throw Error(Msg(Where(), "/", name, " = ", Describe(x), " is a ", TypeName(x),
-                  ", expected a number"));
-}
-
-void ParamSource::Get(const std::string& name, std::string* v) const {
-  Value x;
-  if (!Lookup(name, &x)) return;
-  if (auto* s = std::get_if<std::string>(&x)) {
-    *v = *s;
-    return;
-  }
-  throw Error(Msg(Where(), "/", name, " = ", Describe(x), " is a ", TypeName(x),
-                  ", expected a string"));
-}
-
 bool MapParamSource::Lookup(const std::string& name, Value* value) const {
   auto it = values_.find(name);
   if (it == values_.end()) return false;
@@ -252,6 +63,41 @@ bool MapParamSource::Lookup(const std::string& name, Value* value) const {
 std::vector<std::string> MapParamSource::Names() const {
   std::vector<std::string> out;
   for (const auto& [k, v] : values_) out.push_back(k);
+  return out;
+}
+
+std::string ParamName(const std::string& key) {
+  std::string name = key;
+  for (char& c : name) {
+    if (c == '.') c = '/';
+  }
+  return name;
+}
+
+void ReadParams(const ParamSource& params, OptionRegistry* registry) {
+  for (OptionRegistry::Option& o : registry->options()) {
+    const std::string name = ParamName(o.key());
+    ParamSource::Value v;
+    if (!params.Lookup(name, &v)) continue;
+    try {
+      SetValue(v, &o);
+    } catch (const Error& e) {
+      throw Error(
+          Msg(params.Where(), "/", name, " = ", Describe(v), ": ", e.what()));
+    }
+  }
+}
+
+std::vector<std::string> UnknownParams(const ParamSource& params,
+                                       const OptionRegistry& registry) {
+  std::set<std::string> known;
+  for (const OptionRegistry::Option& o : registry.options()) {
+    known.insert(ParamName(o.key()));
+  }
+  std::vector<std::string> out;
+  for (const std::string& n : params.Names()) {
+    if (!known.count(n)) out.push_back(n);
+  }
   return out;
 }
 
@@ -306,56 +152,248 @@ void FusionNodeOptions::Check() const {
   fusion.Check();
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeSelectionOptions* o) {
+  registry
+      ->Add(OptionRegistry::Join(prefix, "keyframe_min_baseline"),
+            &o->min_baseline, "m from the last keyframe that make a keyframe")
+      .Min(0);
+  registry
+      ->Add(OptionRegistry::Join(prefix, "keyframe_min_angle_deg"),
+            &o->min_angle_deg,
+            "... or this viewing-angle change (degrees) makes a keyframe")
+      .Min(0)
+      .Max(180);
+}
+
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeStoreOptions* o) {
+  registry
+      ->Add(OptionRegistry::Join(prefix, "max_keyframes"), &o->max_keyframes,
+            "keyframe store bound: count (least useful evicted)")
+      .Min(2);
+  registry
+      ->Add(OptionRegistry::Join(prefix, "max_keyframe_mb"), &o->max_mb,
+            "keyframe store bound: image megabytes")
+      .Above(0);
+}
+
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     StreamOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("stamp_reset_threshold"), &o->stamp_reset_threshold,
+            "s: a stamp this far back resets the stream (bag loop); smaller "
+            "steps back are dropped")
+      .Above(0);
+  registry
+      ->Add(key("max_pose_jump"), &o->max_pose_jump,
+            "m between frames < 1 s apart that count as a pose reset, 0 = off")
+      .Min(0);
+  RegisterOptions(registry, prefix, &o->keyframes);
+  RegisterOptions(registry, prefix, &o->store);
+  registry
+      ->Add(key("max_image_size"), &o->max_image_size,
+            "longest image side kept, 0 = as received")
+      .Min(16)
+      .OrZero();
+  registry
+      ->Add(key("num_threads"), &o->num_threads,
+            "threads inside one reconstruction")
+      .Min(1);
+  registry
+      ->Add(key("max_pending"), &o->max_pending,
+            "reconstructions queued or running")
+      .Min(1);
+  registry
+      ->Add(key("min_neighbors"), &o->min_neighbors,
+            "good neighbours (global view selection) before reconstructing")
+      .Min(1);
+  registry
+      ->Add(key("lookahead"), &o->lookahead,
+            "... and this many later keyframes (or idle_flush s without one)")
+      .Min(0);
+  registry
+      ->Add(key("idle_flush"), &o->idle_flush,
+            "s without a new keyframe after which ready keyframes are "
+            "reconstructed")
+      .Min(0);
+  registry
+      ->Add(key("redo_min_gain"), &o->redo_min_gain,
+            "redo a keyframe when its neighbour score grew by this factor, "
+            "0 = never")
+      .Above(1)
+      .OrZero();
+  registry
+      ->Add(key("max_redo"), &o->max_redo,
+            "at most this many redos per keyframe")
+      .Min(0);
+  registry
+      ->Add(key("worker_index"), &o->worker_index,
+            "several workers: this one reconstructs keyframes with index % "
+            "worker_count == worker_index")
+      .Min(0)
+      .Note("< worker_count");
+  registry
+      ->Add(key("worker_count"), &o->worker_count, "number of depth workers")
+      .Min(1);
+  // use_tracker follows the node's sparse_source.
+  RegisterOptions(registry, key("mvs"), &o->mvs);
+  RegisterOptions(registry, key("tracker"), &o->tracker);
+}
+
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     DepthNodeOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("world_frame"), &o->world_frame,
+            "fixed frame of the poses (REP 105)")
+      .Note("not empty");
+  registry
+      ->Add(key("pose_source"), &o->pose_source,
+            "tf: world_frame <- image frame_id at the image stamp; topic: "
+            "`pose` (PoseStamped)")
+      .OneOf({"tf", "topic"});
+  registry
+      ->Add(key("tf_timeout"), &o->tf_timeout,
+            "s to wait for the pose of a frame")
+      .Min(0)
+      .Max(60);
+  registry
+      ->Add(key("pose_sync_tolerance"), &o->pose_sync_tolerance,
+            "s, pose topic stamp match")
+      .Min(0);
+  registry->Add(key("camera_frame"), &o->camera_frame,
+                "camera optical frame; \"\" = the image header's frame_id");
+  registry
+      ->Add(key("image_transport"), &o->image_transport,
+            "image_transport plugin: raw, compressed (decoded here if the "
+            "plugin is missing), theora, ...")
+      .Note("a plugin name, no '/' or ' '");
+  registry->Add(key("camera_info_latest"), &o->camera_info_latest,
+                "false: camera_info paired by exact stamp (CameraSubscriber); "
+                "true: the latest one");
+  registry->Add(key("rectified"), &o->rectified,
+                "images are rectified: camera from P, D ignored (also on for "
+                "an image_rect topic)");
+  registry
+      ->Add(key("depth_encoding"), &o->depth_encoding,
+            "~depth/image_rect: 32FC1 metres, NaN unknown (REP 118); 16UC1 "
+            "millimetres, 0 unknown")
+      .OneOf({"32FC1", "16UC1"});
+  registry
+      ->Add(key("sparse_source"), &o->sparse_source,
+            "tracker (online SIFT tracks), topic (`sparse_points`), none")
+      .OneOf({"tracker", "topic", "none"});
+  registry->Add(key("linearize"), &o->linearize,
+                "inverse sRGB on input images");
+  registry
+      ->Add(key("input_queue_size"), &o->input_queue_size,
+            "frames waiting for the front end; the oldest is dropped "
+            "(counted) beyond it")
+      .Min(1)
+      .Max(1000);
+  registry
+      ->Add(key("diagnostics_period"), &o->diagnostics_period,
+            "s between diagnostics")
+      .Above(0);
+  registry
+      ->Add(key("error_throttle"), &o->error_throttle,
+            "s between repeated errors about the same problem")
+      .Min(0);
+  RegisterOptions(registry, prefix, &o->stream);
+}
+
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     FusionNodeOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry->Add(key("world_frame"), &o->world_frame, "fixed frame of the cloud")
+      .Note("not empty");
+  registry
+      ->Add(key("publish_period"), &o->publish_period,
+            "s, at most one (latched) cloud per period")
+      .Above(0);
+  registry
+      ->Add(key("mesh_period"), &o->mesh_period,
+            "s between mesh Markers (Poisson), 0 = no mesh")
+      .Min(0);
+  registry->Add(key("output_path"), &o->output_path,
+                "PLY saved on shutdown (SIGINT / SIGTERM) when set");
+  registry
+      ->Add(key("input_queue_size"), &o->input_queue_size,
+            "depth views waiting to be fused (oldest dropped, counted)")
+      .Min(1)
+      .Max(1000);
+  registry
+      ->Add(key("reorder_timeout"), &o->reorder_timeout,
+            "s a view waits for a missing earlier keyframe (several workers)")
+      .Min(0);
+  registry
+      ->Add(key("on_new_session"), &o->on_new_session,
+            "depth node reset/restarted (DepthView.session): keep = same "
+            "cloud, reset = save it as <output>_session<N>.ply and start a "
+            "new one")
+      .OneOf({"keep", "reset"});
+  registry
+      ->Add(key("map_store_mb"), &o->map_store_mb,
+            "depth maps kept in memory; older ones spill to spill_dir")
+      .Above(0);
+  registry->Add(key("spill_dir"), &o->spill_dir,
+                "\"\" = a temporary folder, removed at exit");
+  registry
+      ->Add(key("max_published_points"), &o->max_published_points,
+            "rviz cloud subsample (the saved PLY has every point), 0 = all")
+      .Min(0);
+  registry
+      ->Add(key("diagnostics_period"), &o->diagnostics_period,
+            "s between diagnostics")
+      .Above(0);
+  registry
+      ->Add(key("error_throttle"), &o->error_throttle,
+            "s between repeated errors about the same problem")
+      .Min(0);
+  // The core's fusion options, with the node's smaller memory budgets
+  // (map_cache_mb 256, pending_mb 128; the CLI's are 512 and 256).
+  RegisterOptions(registry, key("fusion"), &o->fusion);
+}
+
 DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params) {
   DepthNodeOptions o;
-  Binder b(params);
-  BindDepth(b, &o);
+  OptionRegistry registry;
+  RegisterOptions(&registry, "", &o);
+  ReadParams(params, &registry);
+  o.stream.use_tracker = o.sparse_source == "tracker";
   CheckOptions(o, params);
   return o;
 }
 
 FusionNodeOptions ReadFusionNodeOptions(const ParamSource& params) {
   FusionNodeOptions o;
-  Binder b(params);
-  BindFusionNode(b, &o);
+  OptionRegistry registry;
+  RegisterOptions(&registry, "", &o);
+  ReadParams(params, &registry);
   CheckOptions(o, params);
   return o;
 }
 
-namespace {
-// Every bound parameter's value after reading `params` into fresh options.
-template <typename Options, typename BindFn>
-std::map<std::string, ParamSource::Value> Values(const ParamSource& params,
-                                                 BindFn bind) {
-  Options o;
-  Binder b(params);
-  bind(b, &o);
-  return b.values();
-}
-}  // namespace
-
-std::map<std::string, ParamSource::Value> DepthNodeParamValues(
-    const ParamSource& params) {
-  return Values<DepthNodeOptions>(params, BindDepth);
-}
-
-std::map<std::string, ParamSource::Value> FusionNodeParamValues(
-    const ParamSource& params) {
-  return Values<FusionNodeOptions>(params, BindFusionNode);
-}
-
 std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params) {
   DepthNodeOptions o;
-  MapParamSource empty;
-  Binder b(empty);
-  return Unknown(params, BindDepth(b, &o));
+  OptionRegistry registry;
+  RegisterOptions(&registry, "", &o);
+  return UnknownParams(params, registry);
 }
 
 std::vector<std::string> UnknownFusionNodeParams(const ParamSource& params) {
   FusionNodeOptions o;
-  MapParamSource empty;
-  Binder b(empty);
-  return Unknown(params, BindFusionNode(b, &o));
+  OptionRegistry registry;
+  RegisterOptions(&registry, "", &o);
+  return UnknownParams(params, registry);
 }
 
 }  // namespace ros1

@@ -4,8 +4,11 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 
+#include "option_ranges.h"
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/io/option_yaml.h"
 #include "wild_mvs/ros/params.h"
 
 namespace wild_mvs {
@@ -31,11 +34,18 @@ TEST(Params, ValuesReachTheCoreOptions) {
                     {"worker_index", 1},
                     {"worker_count", 3},
                     {"sparse_source", std::string("topic")},
-                    {"mvs/num_neighbors", 6},
-                    {"mvs/min_ncc", 0.35},
-                    {"mvs/optimize_color_scale", false},
-                    {"tracker/max_features", 1500},
-                    {"max_keyframe_mb", 128.0}});
+                    {"mvs/global/num_neighbors", 6},
+                    {"mvs/local/min_ncc", 0.35},
+                    {"mvs/mpgc/optimize_color_scale", false},
+                    {"tracker/features/max_features", 1500},
+                    {"max_keyframe_mb", 128.0},
+                    // Options the hand-written binder did not have.
+                    {"mvs/mpgc/settle_iterations", 4},
+                    {"mvs/mpgc/full_update_interval", 3},
+                    {"mvs/mpgc/oscillation_iteration", 12},
+                    {"mvs/global/fallback_max_baseline_deg", 30.0},
+                    {"mvs/sweep/num_views", 3},
+                    {"mvs/sweep/min_score", 0.5}});
   const DepthNodeOptions d = ReadDepthNodeOptions(p);
   EXPECT_EQ(d.world_frame, "map");
   EXPECT_DOUBLE_EQ(d.stream.keyframes.min_baseline, 0.2);
@@ -48,6 +58,12 @@ TEST(Params, ValuesReachTheCoreOptions) {
   EXPECT_FALSE(d.stream.mvs.mpgc.optimize_color_scale);
   EXPECT_EQ(d.stream.tracker.features.max_features, 1500);
   EXPECT_DOUBLE_EQ(d.stream.store.max_mb, 128.0);
+  EXPECT_EQ(d.stream.mvs.mpgc.settle_iterations, 4);
+  EXPECT_EQ(d.stream.mvs.mpgc.full_update_interval, 3);
+  EXPECT_EQ(d.stream.mvs.mpgc.oscillation_iteration, 12);
+  EXPECT_DOUBLE_EQ(d.stream.mvs.global.fallback_max_baseline_deg, 30.0);
+  EXPECT_EQ(d.stream.mvs.sweep.num_views, 3);
+  EXPECT_DOUBLE_EQ(d.stream.mvs.sweep.min_score, 0.5);
 
   MapParamSource q({{"publish_period", 0.5},
                     {"output_path", std::string("/tmp/x.ply")},
@@ -60,65 +76,130 @@ TEST(Params, ValuesReachTheCoreOptions) {
   EXPECT_DOUBLE_EQ(f.fusion.depth_tolerance, 0.02);
 }
 
-// config/<node>.yaml as "a/b" -> scalar text.
-std::map<std::string, std::string> FlatYaml(const std::string& file) {
-  std::map<std::string, std::string> out;
+// What rosparam makes of a YAML document loaded into a namespace: nested
+// maps become a/b/c; scalars are typed the YAML way (bool, int, double,
+// else string).
+MapParamSource ParamsFromYaml(const YAML::Node& root) {
+  MapParamSource out;
   std::function<void(const YAML::Node&, const std::string&)> walk =
       [&](const YAML::Node& n, const std::string& prefix) {
         for (const auto& kv : n) {
           const std::string key = prefix + kv.first.as<std::string>();
-          if (kv.second.IsMap())
+          if (kv.second.IsMap()) {
             walk(kv.second, key + "/");
-          else
-            out[key] = kv.second.as<std::string>();
+            continue;
+          }
+          const std::string text = kv.second.Scalar();
+          const bool quoted = kv.second.Tag() == "!";
+          int i = 0;
+          double d = 0;
+          if (!quoted && (text == "true" || text == "false")) {
+            out.Set(key, text == "true");
+          } else if (!quoted && YAML::convert<int>::decode(kv.second, i) &&
+                     text.find_first_of(".eE") == std::string::npos) {
+            out.Set(key, i);
+          } else if (!quoted && YAML::convert<double>::decode(kv.second, d)) {
+            out.Set(key, d);
+          } else {
+            out.Set(key, text);
+          }
         }
       };
-  walk(YAML::LoadFile(file), "");
+  walk(root, "");
   return out;
 }
 
-// The config files say "defaults shown": every parameter of the node is in
-// its file with the value the node uses when the parameter is unset.
-void ExpectYamlShowsDefaults(
-    const std::string& file,
-    const std::map<std::string, ParamSource::Value>& defaults) {
-  const auto yaml = FlatYaml(file);
-  for (const auto& [name, value] : defaults) {
-    SCOPED_TRACE(file + ": " + name);
-    auto it = yaml.find(name);
-    ASSERT_NE(it, yaml.end()) << "parameter missing from the file";
-    const std::string& text = it->second;
-    if (auto* b = std::get_if<bool>(&value)) {
-      EXPECT_EQ(text, *b ? "true" : "false");
-    } else if (auto* i = std::get_if<int>(&value)) {
-      EXPECT_DOUBLE_EQ(std::stod(text), *i);
-    } else if (auto* d = std::get_if<double>(&value)) {
-      EXPECT_DOUBLE_EQ(std::stod(text), *d);
-    } else {
-      EXPECT_EQ(text, std::get<std::string>(value));
-    }
+std::string Dir() { return std::string(WILD_MVS_SOURCE_DIR) + "/config/"; }
+
+// The config files list every parameter with its default (they are
+// generated: test/ros/test_config_files.sh); loaded as rosparam would, every
+// key is known and the values read back to the defaults.
+TEST(Params, ConfigFilesLoadAsTheDefaults) {
+  const MapParamSource depth =
+      ParamsFromYaml(YAML::LoadFile(Dir() + "depth_node.yaml"));
+  EXPECT_TRUE(UnknownDepthNodeParams(depth).empty());
+  const DepthNodeOptions d = ReadDepthNodeOptions(depth);
+  EXPECT_EQ(d.stream.mvs.mpgc.window, MpgcOptions().window);
+  const MapParamSource fusion =
+      ParamsFromYaml(YAML::LoadFile(Dir() + "fusion_node.yaml"));
+  EXPECT_TRUE(UnknownFusionNodeParams(fusion).empty());
+  const FusionNodeOptions f = ReadFusionNodeOptions(fusion);
+  // The fusion node's memory budgets are below the core's (CLI) defaults.
+  EXPECT_DOUBLE_EQ(f.map_store_mb, 256.0);
+  EXPECT_LT(f.fusion.map_cache_mb, FusionOptions().map_cache_mb);
+  EXPECT_LT(f.fusion.pending_mb, FusionOptions().pending_mb);
+  EXPECT_EQ(f.fusion.bbox_min[0], -std::numeric_limits<double>::infinity());
+  // Every parameter is in the file.
+  DepthNodeOptions o;
+  OptionRegistry r;
+  RegisterOptions(&r, "", &o);
+  for (const auto& opt : r.options()) {
+    ParamSource::Value v;
+    EXPECT_TRUE(depth.Lookup(ParamName(opt.key()), &v)) << opt.key();
   }
-  for (const auto& [name, text] : yaml)
-    EXPECT_TRUE(defaults.count(name)) << file << ": unknown key " << name;
 }
 
-TEST(Params, ConfigFilesShowTheDefaults) {
-  const std::string dir = std::string(WILD_MVS_SOURCE_DIR) + "/config/";
-  MapParamSource none;
-  ExpectYamlShowsDefaults(dir + "depth_node.yaml", DepthNodeParamValues(none));
-  ExpectYamlShowsDefaults(dir + "fusion_node.yaml",
-                          FusionNodeParamValues(none));
-  // The fusion node's memory budgets are below the core's (CLI) defaults.
-  const auto f = FusionNodeParamValues(none);
-  EXPECT_DOUBLE_EQ(std::get<double>(f.at("map_store_mb")), 256.0);
-  EXPECT_LT(std::get<double>(f.at("fusion/map_cache_mb")),
-            FusionOptions().map_cache_mb);
-  EXPECT_LT(std::get<double>(f.at("fusion/pending_mb")),
-            FusionOptions().pending_mb);
-  // Values read from parameters are reported as read.
-  const auto set =
-      FusionNodeParamValues(MapParamSource({{"fusion/pending_mb", 32.0}}));
-  EXPECT_DOUBLE_EQ(std::get<double>(set.at("fusion/pending_mb")), 32.0);
+// The mvs: and tracker: sections of config/reconstruct.yaml (the CLI's keys)
+// are the depth node's mvs/ and tracker/ parameters, and fusion: the fusion
+// node's fusion/: a tuned section loads unchanged.
+TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
+  const YAML::Node all = YAML::LoadFile(Dir() + "reconstruct.yaml");
+  for (const char* section : {"mvs", "tracker"}) {
+    YAML::Node only;
+    only[section] = all[section];
+    EXPECT_TRUE(UnknownDepthNodeParams(ParamsFromYaml(only)).empty())
+        << section;
+  }
+  YAML::Node fusion;
+  fusion["fusion"] = all["fusion"];
+  EXPECT_TRUE(UnknownFusionNodeParams(ParamsFromYaml(fusion)).empty());
+
+  const std::string tuned =
+      "mvs:\n"
+      "  use_color: false\n"
+      "  global: {num_neighbors: 6, fallback_max_baseline_deg: 30}\n"
+      "  rescaling: {enabled: false}\n"
+      "  local: {enabled: false, num_active: 5}\n"
+      "  mpgc: {window: 7, drop_ncc: 0.5, convergence_eps: 0.002}\n"
+      "  sweep: {step: 4, num_views: 3, min_score: 0.55}\n"
+      "tracker:\n"
+      "  features: {downscale: 2.0, max_features: 1234}\n"
+      "  ratio: 0.7\n";
+  // The CLI's reading of the text ...
+  MvsOptions mvs;
+  TrackerOptions tracker;
+  OptionRegistry cli;
+  RegisterOptions(&cli, "mvs", &mvs);
+  RegisterOptions(&cli, "tracker", &tracker);
+  LoadOptionsYamlString(&cli, tuned, "tuned");
+  // ... and the depth node's (rosparam load into its namespace).
+  const DepthNodeOptions d =
+      ReadDepthNodeOptions(ParamsFromYaml(YAML::Load(tuned)));
+  DepthNodeOptions node = d;
+  OptionRegistry r;
+  RegisterOptions(&r, "", &node);
+  for (const auto& o : cli.options()) {
+    const OptionRegistry::Option* n = r.Find(o.key());
+    ASSERT_NE(n, nullptr) << o.key() << " is not a depth node parameter";
+    EXPECT_EQ(n->Text(), o.Text()) << o.key();
+  }
+  EXPECT_EQ(d.stream.mvs.mpgc.window, 7);
+  EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.drop_ncc, 0.5);
+  EXPECT_FALSE(d.stream.mvs.rescaling.enabled);
+  EXPECT_FALSE(d.stream.mvs.local.enabled);
+  EXPECT_EQ(d.stream.mvs.sweep.step, 4);
+  EXPECT_DOUBLE_EQ(d.stream.tracker.features.downscale, 2.0);
+}
+
+TEST(Params, RangesAgreeWithCheck) {
+  test::ExpectRangesAgreeWithCheck<DepthNodeOptions>(
+      [](DepthNodeOptions* o, OptionRegistry* r) {
+        RegisterOptions(r, "", o);
+      });
+  test::ExpectRangesAgreeWithCheck<FusionNodeOptions>(
+      [](FusionNodeOptions* o, OptionRegistry* r) {
+        RegisterOptions(r, "", o);
+      });
 }
 
 std::string ErrorOf(const MapParamSource& p) {
@@ -142,7 +223,11 @@ TEST(Params, BadValuesNameTheParameter) {
   EXPECT_NE(
       ErrorOf(MapParamSource({{"max_keyframes", 2.5}})).find("max_keyframes"),
       std::string::npos);
-  EXPECT_NE(ErrorOf(MapParamSource({{"mvs/min_ncc", 3.0}})).find("ncc"),
+  EXPECT_NE(
+      ErrorOf(MapParamSource({{"mvs/local/min_ncc", 3.0}})).find("min_ncc"),
+      std::string::npos);
+  // Check()'s message: the window must be odd.
+  EXPECT_NE(ErrorOf(MapParamSource({{"mvs/mpgc/window", 4}})).find("odd"),
             std::string::npos);
   EXPECT_NE(ErrorOf(MapParamSource({{"linearize", 1}})).find("linearize"),
             std::string::npos);
@@ -168,6 +253,16 @@ TEST(Params, UnknownParametersAreListed) {
   const auto unknown = UnknownDepthNodeParams(p);
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_EQ(unknown[0], "keyframe_min_angel");
+  // The keys before the registry (renamed: docs/ROS.md) are unknown now.
+  EXPECT_EQ(
+      UnknownDepthNodeParams(MapParamSource({{"mvs/window", 5},
+                                             {"mvs/rescaling", true},
+                                             {"mvs/local_view_selection", true},
+                                             {"mvs/sweep_step", 8},
+                                             {"tracker/feature_downscale", 1.0},
+                                             {"mvs/mpgc/window", 5}}))
+          .size(),
+      5u);
   EXPECT_TRUE(
       UnknownFusionNodeParams(MapParamSource({{"fusion/min_support", 3}}))
           .empty());

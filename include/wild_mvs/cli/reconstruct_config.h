@@ -10,9 +10,13 @@
 //              mvs.growing, mvs.sweep: the per-view depth map)
 //   fusion.*   FusionOptions (consistency-checked fusion)
 //   meshing.*  MeshingOptions (screened Poisson, trimming, decimation)
-// Keys are the C++ member names, so the headers document them.
+// Keys are the C++ member names, so the headers document them; each struct
+// registers its fields beside its definition (core/option_registry.h), with
+// the valid range its Check() states. The depth node reads the same mvs.* and
+// tracker.* keys from ~mvs/... and ~tracker/... (docs/ROS.md).
 // The default config file config/reconstruct.yaml is exactly
-// `wild_mvs reconstruct --dump-config` with the defaults (a test checks it).
+// `wild_mvs reconstruct --dump-config` with the defaults, written by
+// wild_mvs_write_config (a test checks it).
 #pragma once
 
 #include <string>
@@ -36,6 +40,9 @@ struct RunOptions {
   void Check() const;
   bool HasStage(const std::string& stage) const;
 };
+// Registers the fields under `prefix` ("run").
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     RunOptions* options);
 
 struct ReconstructConfig {
   RunOptions run;
@@ -48,8 +55,8 @@ struct ReconstructConfig {
   void Check() const;
 };
 
-// Binds every field of `config` to its section.key in `set`.
-void RegisterOptions(ReconstructConfig* config, OptionSet* set);
+// Registers every field of `config` under its section.key.
+void RegisterOptions(ReconstructConfig* config, OptionRegistry* registry);
 
 }  // namespace cli
 }  // namespace wild_mvs

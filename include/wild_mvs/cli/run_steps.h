@@ -103,7 +103,7 @@ MeshResult RunMeshStage(const PointCloud& cloud,
 struct DatasetRecord {
   std::string path, model, images, format = "auto", mask_dir;
 };
-void RegisterDatasetRecord(DatasetRecord* record, OptionSet* set);
+void RegisterDatasetRecord(DatasetRecord* record, OptionRegistry* registry);
 std::string RunRecordPath(const std::string& out);
 
 }  // namespace cli

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "wild_mvs/core/mpgc.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/region_growing.h"
 #include "wild_mvs/core/thread_pool.h"
 
@@ -19,6 +20,9 @@ struct DepthSweepOptions {
   double min_score = 0.6;  // (choice) seed only above this mean NCC
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs.sweep".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     DepthSweepOptions* options);
 
 // Seeds from the sweep over [min_depth, max_depth] (z in R). Deterministic;
 // parallel over grid rows when pool is given. *pool_cpu_seconds += the CPU

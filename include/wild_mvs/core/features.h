@@ -15,6 +15,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "wild_mvs/core/option_registry.h"
+
 namespace wild_mvs {
 
 struct FeatureOptions {
@@ -46,6 +48,10 @@ struct FeatureOptions {
   bool root_sift = true;
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g.
+// "tracker.features".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     FeatureOptions* options);
 
 // Features of one view. Descriptors are 128 bytes each (CV_8U), unit L2 norm
 // scaled by kDescriptorScale, so the L2 distance of two normalised

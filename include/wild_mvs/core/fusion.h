@@ -58,6 +58,7 @@
 #include <vector>
 
 #include "wild_mvs/core/depth_map.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/point_cloud.h"
 #include "wild_mvs/core/thread_pool.h"
 
@@ -101,6 +102,9 @@ struct FusionOptions {
 
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "fusion".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     FusionOptions* options);
 
 // view -> its depth map (may load from disk). For the view being added it
 // must return a map (nullptr is an Error); for an earlier view it may return

@@ -12,9 +12,11 @@
 // confirmed by another view's independent estimate, a right one usually is.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "wild_mvs/core/depth_map.h"
+#include "wild_mvs/core/option_registry.h"
 
 namespace wild_mvs {
 
@@ -27,6 +29,10 @@ struct GeometricConsistencyOptions {
   double max_relative_depth = 0.01;  // |z' - z| / z
   void Check() const;
 };
+
+// Registers the fields under `prefix` (option_registry.h).
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     GeometricConsistencyOptions* options);
 
 struct ConsistencyStats {
   long long samples = 0;  // valid samples before

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/scene.h"
 
 namespace wild_mvs {
@@ -23,6 +24,9 @@ struct GlobalViewSelectionOptions {
   double fallback_max_baseline_deg = 45;
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs.global".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     GlobalViewSelectionOptions* options);
 
 struct GlobalViewSelection {
   std::vector<int> neighbors;          // scene view indices, in selection order

@@ -16,6 +16,7 @@
 #include <string>
 #include <utility>
 
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/scene.h"
 
 namespace wild_mvs {
@@ -32,6 +33,9 @@ struct ImageOptions {
   int max_image_size = 0;
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "image".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     ImageOptions* options);
 
 // sRGB <-> linear for one value in [0, 1].
 float SrgbToLinear(float v);

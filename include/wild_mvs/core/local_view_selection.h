@@ -6,6 +6,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 
+#include "wild_mvs/core/option_registry.h"
+
 namespace wild_mvs {
 
 struct LocalViewSelectionOptions {
@@ -17,6 +19,9 @@ struct LocalViewSelectionOptions {
   double min_ncc = 0.3;                // NCC to enter A (paper: 0.3)
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs.local".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     LocalViewSelectionOptions* options);
 
 // Direction (unit 2-vector) of the epipolar line in R through pixel (x, y)
 // induced by the view whose centre projects to the homogeneous epipole e

@@ -14,6 +14,7 @@
 
 #include <cstddef>
 
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/point_cloud.h"
 
 namespace wild_mvs {
@@ -43,6 +44,9 @@ struct MeshingOptions {
 
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "meshing".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MeshingOptions* options);
 
 struct MeshingStats {
   size_t input_points = 0;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "wild_mvs/core/local_view_selection.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/patch.h"
 
 namespace wild_mvs {
@@ -53,6 +54,9 @@ struct MpgcOptions {
   bool optimize_color_scale = true;  // false = scales fixed to 1 (lab data)
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs.mpgc".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MpgcOptions* options);
 
 // What happened in one Match call, iteration by iteration (tests and
 // debugging; Match records it only when given one). `iteration` counts the

@@ -14,6 +14,7 @@
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/core/local_view_selection.h"
 #include "wild_mvs/core/mpgc.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/region_growing.h"
 #include "wild_mvs/core/rescaling.h"
 #include "wild_mvs/core/scene.h"
@@ -35,6 +36,9 @@ struct MvsOptions {
   int max_image_size = 0;  // longest side of R's working image; 0 = any
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     MvsOptions* options);
 
 // The paper's pipeline with the paper's values (Goesele et al. 2007,
 // section 6 and MVE's dmrecon where the paper is silent): no acceptance

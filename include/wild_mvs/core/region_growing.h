@@ -16,6 +16,7 @@
 
 #include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/mpgc.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/thread_pool.h"
 
 namespace wild_mvs {
@@ -35,6 +36,9 @@ struct RegionGrowingOptions {
   double revisit_margin = 0.1;
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs.growing".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     RegionGrowingOptions* options);
 
 struct Seed {
   int x = 0, y = 0;  // pixel (column, row) of R's working image

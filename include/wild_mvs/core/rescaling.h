@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/scene.h"
 
 namespace wild_mvs {
@@ -14,6 +15,10 @@ struct RescalingOptions {
   double max_scale = 1.2;  // downsample neighbours above this (paper: 1.2)
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g.
+// "mvs.rescaling".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     RescalingOptions* options);
 
 // scale_R(V) = mean over shared features of s_R(f) / s_V(f). Without shared
 // features, the ratio of the pixel footprints at `fallback_point` (a point

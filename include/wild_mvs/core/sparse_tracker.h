@@ -27,6 +27,7 @@
 #include "wild_mvs/core/camera.h"
 #include "wild_mvs/core/features.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/core/thread_pool.h"
 
@@ -97,6 +98,9 @@ struct TrackerOptions {
 
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h), e.g. "tracker".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     TrackerOptions* options);
 
 // Counters for logs and diagnostics.
 struct TrackerStats {

@@ -1,11 +1,17 @@
-// Copyright wild_mvs authors. The ONE place where ROS parameters become
-// option structs (the nodes' own options and the core's option structs).
+// Copyright wild_mvs authors. ROS parameters become option structs by
+// walking the option registry (core/option_registry.h): the key
+// mvs.mpgc.drop_ncc of the command line and config/reconstruct.yaml is the
+// private parameter ~mvs/mpgc/drop_ncc, so a tuned reconstruct.yaml section
+// (mvs:, tracker:, fusion:) loads into a node's namespace unchanged.
 //
-// Parameters are private (~name). Every value is type- and range-checked:
-// a bad value throws wild_mvs::Error naming the parameter and the value, so a
-// node refuses to start with a clear message instead of running with a wrong
-// setting. Unknown private parameters are reported as warnings
-// (UnknownParams) since launch files may carry extra keys.
+// Parameters are private (~name). Every value is type-checked here and
+// range-checked by the options' Check(): a bad value throws wild_mvs::Error
+// naming the parameter and the value, so a node refuses to start with a
+// clear message instead of running with a wrong setting. Unknown private
+// parameters are reported as warnings (Unknown*Params) since launch files
+// may carry extra keys. config/depth_node.yaml and config/fusion_node.yaml
+// list every parameter with its default and range; they are written by
+// wild_mvs_write_config from the same registry (a test keeps them equal).
 //
 // The reading goes through ParamSource so the mapping is unit-tested without
 // a ROS master (MapParamSource); RosParamSource (params_ros.h) reads a
@@ -18,31 +24,25 @@
 #include <vector>
 
 #include "wild_mvs/core/fusion.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/ros/stream_reconstructor.h"
 
 namespace wild_mvs {
 namespace ros1 {
 
-// A typed parameter lookup. Get returns false when the parameter is not set
-// and throws Error when it is set with an incompatible type (an int is
-// accepted for a double).
+// A parameter lookup.
 class ParamSource {
  public:
   using Value = std::variant<bool, int, double, std::string>;
   virtual ~ParamSource() = default;
-  // The value of private parameter `name`, or false when it is unset.
+  // The value of private parameter `name` ("mvs/mpgc/drop_ncc"), or false
+  // when it is unset.
   virtual bool Lookup(const std::string& name, Value* value) const = 0;
   // Names (without the private prefix) of every private parameter that is
   // set, for the unknown-key check.
   virtual std::vector<std::string> Names() const = 0;
   // Where the parameters come from, for messages ("/depth_node").
   virtual std::string Where() const = 0;
-
-  // Typed getters: leave *v untouched when unset.
-  void Get(const std::string& name, bool* v) const;
-  void Get(const std::string& name, int* v) const;
-  void Get(const std::string& name, double* v) const;
-  void Get(const std::string& name, std::string* v) const;
 };
 
 // In-memory parameters (tests, tools).
@@ -58,6 +58,18 @@ class MapParamSource : public ParamSource {
  private:
   std::map<std::string, Value> values_;
 };
+
+// The parameter name of a registry key: "mvs.mpgc.drop_ncc" ->
+// "mvs/mpgc/drop_ncc".
+std::string ParamName(const std::string& key);
+// Sets every registered option whose parameter is set; throws Error naming
+// "<where>/<param>" when a value's type does not fit (an int is accepted for
+// a double, an integral double for an int). Ranges are left to Check().
+void ReadParams(const ParamSource& params, OptionRegistry* registry);
+// Set parameters that name no registered option (typos), e.g.
+// "keyframe_min_angel".
+std::vector<std::string> UnknownParams(const ParamSource& params,
+                                       const OptionRegistry& registry);
 
 // Options of the depth node (its ROS-side settings plus the stream
 // reconstructor's and the core's options).
@@ -145,17 +157,29 @@ struct FusionNodeOptions {
   }
 };
 
+// The nodes' option structs in the registry. The depth node's own options
+// and its StreamOptions are top-level parameters (world_frame, num_threads,
+// keyframe_min_baseline, ...); StreamOptions::mvs and ::tracker are the
+// sections mvs/ and tracker/, FusionNodeOptions::fusion is fusion/, with the
+// core's keys (mvs/mpgc/drop_ncc). `prefix` is "" for a node.
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     DepthNodeOptions* options);
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     FusionNodeOptions* options);
+// StreamOptions and the keyframe options are registered in params.cpp, not
+// beside their structs, while the stream code moves out of src/ros; they
+// belong beside the structs afterwards.
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     StreamOptions* options);
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeSelectionOptions* options);
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeStoreOptions* options);
+
 // Reads the options (defaults for unset parameters), checks them, and throws
-// Error naming "<where>/~<param>" on a bad value.
+// Error naming "<where>/<param>" or the option on a bad value.
 DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params);
 FusionNodeOptions ReadFusionNodeOptions(const ParamSource& params);
-// Every parameter of the node with its value (the default when `params`
-// does not set it), e.g. "fusion/map_cache_mb" -> 256.0. config/*.yaml
-// shows these defaults (a test compares them).
-std::map<std::string, ParamSource::Value> DepthNodeParamValues(
-    const ParamSource& params);
-std::map<std::string, ParamSource::Value> FusionNodeParamValues(
-    const ParamSource& params);
 // Private parameters that the node does not know (typos), e.g.
 // "keyframe_min_angel".
 std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params);

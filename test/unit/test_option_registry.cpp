@@ -1,0 +1,139 @@
+// Copyright wild_mvs authors. The option registry: keys, parsing, YAML round
+// trip, and the documented ranges agree with Check().
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <set>
+
+#include "option_ranges.h"
+#include "wild_mvs/cli/option_set.h"
+#include "wild_mvs/cli/reconstruct_config.h"
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/option_registry.h"
+#include "wild_mvs/io/option_yaml.h"
+
+namespace wild_mvs {
+namespace {
+
+TEST(OptionRegistry, StructNestingGivesTheKeys) {
+  cli::ReconstructConfig c;
+  OptionRegistry r;
+  cli::RegisterOptions(&c, &r);
+  for (const char* key : {"run.threads",
+                          "image.cache_mb",
+                          "tracker.features.downscale",
+                          "tracker.max_neighbors",
+                          "mvs.use_color",
+                          "mvs.global.num_neighbors",
+                          "mvs.global.fallback_max_baseline_deg",
+                          "mvs.rescaling.enabled",
+                          "mvs.local.enabled",
+                          "mvs.mpgc.window",
+                          "mvs.mpgc.drop_ncc",
+                          "mvs.mpgc.settle_iterations",
+                          "mvs.mpgc.full_update_interval",
+                          "mvs.mpgc.oscillation_iteration",
+                          "mvs.growing.revisit_margin",
+                          "mvs.sweep.step",
+                          "mvs.sweep.num_views",
+                          "mvs.sweep.min_score",
+                          "fusion.bbox_min_x",
+                          "fusion.pending_mb",
+                          "meshing.depth"}) {
+    EXPECT_TRUE(r.Has(key)) << key;
+  }
+  // Each key points at its field.
+  r.Find("mvs.mpgc.drop_ncc")->SetText("0.55");
+  EXPECT_DOUBLE_EQ(c.mvs.mpgc.drop_ncc, 0.55);
+  r.Find("mvs.mpgc.window")->SetInt(7);
+  EXPECT_EQ(c.mvs.mpgc.window, 7);
+  r.Find("tracker.features.downscale")->SetInt(2);  // int for a double
+  EXPECT_DOUBLE_EQ(c.tracker.features.downscale, 2.0);
+  r.Find("mvs.local.enabled")->SetBool(false);
+  EXPECT_FALSE(c.mvs.local.enabled);
+  r.Find("run.stages")->SetString("depth");
+  EXPECT_EQ(c.run.stages, "depth");
+  // Every key is unique and every option has help.
+  std::set<std::string> keys;
+  for (const auto& o : r.options()) {
+    EXPECT_TRUE(keys.insert(o.key()).second) << o.key();
+    EXPECT_FALSE(o.help().empty()) << o.key();
+  }
+  EXPECT_THROW(r.Add("run.threads", &c.run.threads, "again"), Error);
+}
+
+TEST(OptionRegistry, ParsesByTypeOnly) {
+  int i = 0;
+  double d = 0, box = 0;
+  bool b = false;
+  std::string s;
+  OptionRegistry r;
+  r.Add("a.i", &i, "int").Min(0);
+  r.Add("a.d", &d, "double");
+  r.Add("a.box", &box, "open bound").Infinite();
+  r.Add("a.b", &b, "bool");
+  r.Add("a.s", &s, "string");
+  r.Set("a.i", "-5", "here");  // out of the stated range: Check()'s job
+  EXPECT_EQ(i, -5);
+  EXPECT_THROW(r.Set("a.i", "2.5", "here"), Error);
+  EXPECT_THROW(r.Set("a.i", "99999999999", "here"), Error);
+  EXPECT_THROW(r.Set("a.d", "nan", "here"), Error);
+  EXPECT_THROW(r.Set("a.d", "inf", "here"), Error);
+  r.Set("a.box", "-.inf", "here");
+  EXPECT_EQ(box, -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(r.Find("a.box")->Text(), "-.inf");
+  EXPECT_THROW(r.Set("a.b", "maybe", "here"), Error);
+  EXPECT_THROW(r.Find("a.b")->SetInt(1), Error);
+  EXPECT_THROW(r.Find("a.i")->SetDouble(1.5), Error);
+  EXPECT_THROW(r.Find("a.s")->SetDouble(1.5), Error);
+  try {
+    r.Set("a.x", "1", "option --a.x");
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("known in this section: a.i"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(OptionRegistry, RangeText) {
+  int w = 5, z = 0;
+  double x = 0;
+  OptionRegistry r;
+  EXPECT_EQ(r.Add("w", &w, "").Min(3).Max(9).Odd().RangeText(), "odd, [3, 9]");
+  EXPECT_EQ(r.Add("z", &z, "").Min(64).OrZero().RangeText(), "0 or >= 64");
+  EXPECT_EQ(r.Add("x", &x, "").Above(0).Below(1).RangeText(), "(0, 1)");
+}
+
+TEST(OptionRegistry, ReconstructRangesAgreeWithCheck) {
+  test::ExpectRangesAgreeWithCheck<cli::ReconstructConfig>(
+      [](cli::ReconstructConfig* c, OptionRegistry* r) {
+        cli::RegisterOptions(c, r);
+      });
+}
+
+TEST(OptionRegistry, YamlRoundTrip) {
+  cli::ReconstructConfig a;
+  cli::OptionSet ra;
+  cli::RegisterOptions(&a, &ra);
+  ra.Set("mvs.mpgc.drop_ncc", "0.45", "test");
+  ra.Set("fusion.bbox_max_z", "3.5", "test");
+  ra.Set("run.stages", "depth,fuse", "test");
+  const std::string yaml = ra.ToYaml(true);
+  EXPECT_NE(yaml.find("    # matching window side n of n x n (paper: 5) "
+                      "(odd, [3, 9])\n    window: 5\n"),
+            std::string::npos)
+      << yaml;
+  cli::ReconstructConfig b;
+  cli::OptionSet rb;
+  cli::RegisterOptions(&b, &rb);
+  rb.LoadYamlString(yaml, "dump");
+  EXPECT_EQ(rb.ToYaml(true), yaml);
+  EXPECT_DOUBLE_EQ(b.mvs.mpgc.drop_ncc, 0.45);
+  EXPECT_DOUBLE_EQ(b.fusion.bbox_max[2], 3.5);
+  EXPECT_EQ(b.fusion.bbox_min[0], -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(b.run.stages, "depth,fuse");
+}
+
+}  // namespace
+}  // namespace wild_mvs
