@@ -7,7 +7,9 @@
 #     (fraction of ground-truth pixels with an estimate within 1 % of the
 #     truth), fraction of the estimates within 0.5 % / 1 %, off by more
 #     than 5 %, estimates where there is no surface (sky) among all
-#     estimates, median relative error;
+#     estimates, median relative error, and the fraction of the samples
+#     within 1 % that the fused cloud represents (a point within two pixel
+#     footprints);
 #   fused cloud (`wild_mvs eval cloud`, against a cloud from the ground-truth
 #     depth, both thinned to 5 mm voxels): precision / recall / F at 1, 2
 #     and 5 cm;
@@ -52,7 +54,7 @@ fi
 BIN="$BUILD_DIR/bin"
 mkdir -p "$OUT"
 TSV="$OUT/$TAG.tsv"
-printf 'scene\tcomplete@1%%\twithin0.5%%\twithin1%%\toff>5%%\tsky\tmedian_rel\tF@1cm\tF@2cm\tF@5cm\tP@1cm\tR@1cm\tcloud_pts\tcpu_s\trss_mb\n' >"$TSV"
+printf 'scene\tcomplete@1%%\twithin0.5%%\twithin1%%\toff>5%%\tsky\tmedian_rel\trepresented\tF@1cm\tF@2cm\tF@5cm\tP@1cm\tR@1cm\tcloud_pts\tcpu_s\trss_mb\n' >"$TSV"
 for kind in $KINDS; do
   scene="$OUT/scenes/${kind}_$VIEWS"
   [ "$POINTS" = 1500 ] || scene="${scene}_p$POINTS"
@@ -69,7 +71,8 @@ for kind in $KINDS; do
     ${EXTRA[@]+"${EXTRA[@]}"} 2>"$OUT/$TAG.$kind.log"
   read -r user sys rss <"$OUT/time.txt"
   "$BIN/wild_mvs" eval depth --est "$run" --gt-dir "$scene/gt_depth" \
-    --rel-thresholds 0.005,0.01,0.05 --json "$run/eval_depth.json" >/dev/null
+    --rel-thresholds 0.01,0.005,0.05 --cloud "$run/fused.ply" \
+    --json "$run/eval_depth.json" >/dev/null
   "$BIN/wild_mvs" eval cloud "$run/fused.ply" "$gt" --tau 0.01,0.02,0.05 \
     --voxel 0.005 --json "$run/eval_cloud.json" >/dev/null
   python3 - "$run" "$kind" "$user" "$sys" "$rss" >>"$TSV" <<'PY'
@@ -82,9 +85,10 @@ est = d["estimated"]
 sky = d["outside_gt"] / est if est else 0
 f = c["fscore"]
 p = c.get("precision", []); r = c.get("recall", [])
-print("\t".join([kind, "%.3f" % comp[1], "%.3f" % acc[0], "%.3f" % acc[1],
+print("\t".join([kind, "%.3f" % comp[0], "%.3f" % acc[1], "%.3f" % acc[0],
                  "%.4f" % (1 - acc[2]), "%.4f" % sky,
-                 "%.5f" % d["median_rel_error"]] +
+                 "%.5f" % d["median_rel_error"],
+                 "%.3f" % d.get("cloud_represented", float("nan"))] +
                 ["%.3f" % x for x in f] + ["%.3f" % p[0], "%.3f" % r[0]] +
                 [str(c["reconstruction_points"]),
                  "%.1f" % (float(user) + float(sys_s)),

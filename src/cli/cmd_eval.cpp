@@ -1,6 +1,7 @@
 // Copyright wild_mvs authors. `wild_mvs eval`: depth maps and point clouds
 // against ground truth, and ground-truth clouds from ground-truth depth.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -82,6 +83,11 @@ std::vector<std::string> DepthMapStems(const std::string& out) {
   return stems;
 }
 
+PointCloud ReadCloudOrMeshVertices(const std::string& path) {
+  // A mesh's vertices are scored like a cloud.
+  return ReadPlyCloud(path);
+}
+
 int EvalDepth(const Args& args) {
   Require(args.Has("est"), "eval depth needs --est OUT (a reconstruct folder)");
   Require(args.Has("gt-dir") || args.Has("dataset"),
@@ -106,6 +112,10 @@ int EvalDepth(const Args& args) {
   // views, and score each view too.
   std::vector<cv::Mat> all_est, all_gt;
   int views = 0, missing = 0;
+  // --cloud: how many of the correct depth samples the cloud represents.
+  const bool with_cloud = args.Has("cloud");
+  PointCloud correct;
+  std::vector<double> footprint;
   std::printf("%-20s %8s %10s %10s %12s\n", "view", "complete", "rel<1st",
               "abs<1st", "median abs");
   for (const std::string& stem : DepthMapStems(out)) {
@@ -142,6 +152,22 @@ int EvalDepth(const Args& args) {
         continue;
       }
     }
+    if (with_cloud) {
+      // The samples within the first relative threshold of the truth, as
+      // points with their pixel footprint.
+      for (int r = 0; r < m.depth.rows; ++r) {
+        for (int c = 0; c < m.depth.cols; ++c) {
+          const float z = m.depth.at<float>(r, c), g = gt.at<float>(r, c);
+          if (!(z > 0) || !(g > 0) ||
+              std::abs(z - g) > opt.relative_thresholds[0] * g)
+            continue;
+          correct.xyz.push_back(
+              m.camera.Backproject(Eigen::Vector2d(c + 0.5, r + 0.5), z)
+                  .cast<float>());
+          footprint.push_back(z / m.camera.fx);
+        }
+      }
+    }
     const DepthMetrics dm = EvaluateDepth(m.depth, gt, opt);
     std::printf("%-20s %7.1f%% %9.1f%% %9.1f%% %12.5g\n", stem.c_str(),
                 100 * dm.completeness, 100 * dm.relative_accuracy[0],
@@ -161,13 +187,27 @@ int EvalDepth(const Args& args) {
                         : std::string())
             << ":\n"
             << total.ToString();
-  WriteJson(args, total.ToJson());
+  std::string json = total.ToJson();
+  if (with_cloud) {
+    const PointCloud cloud = ReadCloudOrMeshVertices(args.Get("cloud"));
+    Require(!cloud.empty(), args.Get("cloud"), ": the cloud is empty");
+    const std::vector<double> d = NearestDistances(correct, cloud, 0);
+    size_t represented = 0;
+    for (size_t i = 0; i < d.size(); ++i)
+      represented += d[i] <= 2.0 * footprint[i];
+    const double frac =
+        d.empty() ? 0.0 : static_cast<double>(represented) / d.size();
+    std::cout << "cloud " << args.Get("cloud") << ": represents " << represented
+              << " of the " << d.size() << " depth samples within "
+              << opt.relative_thresholds[0] * 100
+              << " % of the truth (a point within 2 pixel footprints): "
+              << frac * 100 << " %\n";
+    json.pop_back();  // '}'
+    json += Msg(", \"cloud_represented\": ", frac,
+                ", \"correct_samples\": ", d.size(), "}");
+  }
+  WriteJson(args, json);
   return 0;
-}
-
-PointCloud ReadCloudOrMeshVertices(const std::string& path) {
-  // A mesh's vertices are scored like a cloud.
-  return ReadPlyCloud(path);
 }
 
 int EvalCloud(const Args& args) {

@@ -134,6 +134,11 @@ CommandSpec EvalSpec() {
        "distance thresholds in scene units (cloud mode; default "
        "0.01,0.02,0.05)",
        ""},
+      {"cloud", "FILE.ply",
+       "depth mode: also report the fraction of the depth samples within "
+       "the first relative threshold that FILE (e.g. fused.ply) represents "
+       "(a point within 2 pixel footprints)",
+       ""},
       {"rel-thresholds", "LIST",
        "relative depth-error thresholds (depth mode; default 0.01,0.02,0.05)",
        ""},
