@@ -35,6 +35,7 @@ MvsOptions PaperMvsOptions() {
   o.mpgc.min_texture_levels = 0;
   o.mpgc.normal_step_halvings = 0;
   o.growing.revisit_margin = 0;
+  o.growing.hypotheses = 0;
   o.consistency.enabled = false;
   return o;
 }

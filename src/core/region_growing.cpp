@@ -3,8 +3,10 @@
 
 #include <time.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -19,6 +21,8 @@ void RegionGrowingOptions::Check() const {
   Require(revisit_margin >= 0 && revisit_margin <= 2,
           "growing.revisit_margin = ", revisit_margin,
           " must be in [0, 2] (NCC units)");
+  Require(hypotheses >= 0 && hypotheses <= 16,
+          "growing.hypotheses = ", hypotheses, " must be in [0, 16]");
 }
 
 double ThreadCpuSeconds() {
@@ -96,6 +100,261 @@ class MatcherPool {
 
 }  // namespace
 
+namespace {
+
+// The state of one GrowRegions call: R's maps, the tiles with their queues
+// and inboxes, and the matchers. Its methods are the paper's steps: seed,
+// grow (per tile, best first), merge the hand-offs between tiles.
+class RegionGrower {
+ public:
+  RegionGrower(const PatchContext& context, const MpgcOptions& mpgc,
+               const LocalViewSelectionOptions& local,
+               const RegionGrowingOptions& options, const cv::Mat& mask,
+               cv::Mat* depth, cv::Mat* normal, cv::Mat* confidence)
+      : ctx_(context),
+        cam_(context.ref_camera),
+        opt_(options),
+        matchers_(context, mpgc, local),
+        W_(context.ref_image.width),
+        H_(context.ref_image.height),
+        T_(options.tile_size),
+        ntx_((W_ + T_ - 1) / T_),
+        nty_((H_ + T_ - 1) / T_),
+        queues_(ntx_ * nty_),
+        outbox_(ntx_ * nty_),
+        visits_(ntx_ * nty_, 0),
+        // Given in NCC units; confidence = (NCC + 1) / 2.
+        margin_(static_cast<float>(0.5 * options.revisit_margin)),
+        min_score_(mpgc.drop_ncc) {
+    if (!mask.empty()) mask_ = mask.isContinuous() ? mask : mask.clone();
+    mmap_ = mask_.empty() ? nullptr : mask_.ptr<uint8_t>();
+    dmap_ = depth->ptr<float>();
+    nmap_ = normal->ptr<float>();
+    cmap_ = confidence->ptr<float>();
+  }
+
+  // Seeds: matched fronto-parallel, in parallel; successes fill the queues
+  // in seed order.
+  void SeedQueues(const std::vector<Seed>& seeds, ThreadPool* pool) {
+    const Eigen::Vector3d fronto(0, 0, -1);
+    std::vector<int> ok(seeds.size(), 0);
+    std::vector<PatchResult> res(seeds.size());
+    {
+      auto probe = matchers_.Acquire();
+      for (size_t i = 0; i < seeds.size(); ++i) {
+        const Seed& s = seeds[i];
+        if (s.x < 0 || s.y < 0 || s.x >= W_ || s.y >= H_) continue;
+        if (mmap_ && !mmap_[s.y * W_ + s.x]) continue;
+        if (!probe->WindowInside(s.x, s.y) || !(s.depth > 0)) continue;
+        ok[i] = 1;
+        ++stats_.seeds_tried;
+      }
+      matchers_.Release(std::move(probe));
+    }
+    const int chunk = 64;
+    const int nchunks = static_cast<int>((seeds.size() + chunk - 1) / chunk);
+    stats_.cpu_seconds += RunParallel(pool, nchunks, [&](int ci) {
+      auto m = matchers_.Acquire();
+      const size_t end =
+          std::min(seeds.size(), static_cast<size_t>(ci + 1) * chunk);
+      for (size_t i = static_cast<size_t>(ci) * chunk; i < end; ++i) {
+        if (ok[i] &&
+            !m->Match(seeds[i].x, seeds[i].y, seeds[i].depth, fronto, &res[i]))
+          ok[i] = 0;
+      }
+      matchers_.Release(std::move(m));
+    });
+    stats_.pixel_visits += stats_.seeds_tried;
+    for (size_t i = 0; i < seeds.size(); ++i) {
+      if (!ok[i]) continue;
+      ++stats_.seeds_accepted;
+      const PatchResult& r = res[i];
+      Candidate c;
+      c.conf = static_cast<float>(r.confidence);
+      c.pixel = seeds[i].y * W_ + seeds[i].x;
+      c.depth = static_cast<float>(r.depth);
+      for (int k = 0; k < 3; ++k) c.normal[k] = static_cast<float>(r.normal[k]);
+      Push(&queues_[TileOf(seeds[i].x, seeds[i].y)], c);
+    }
+  }
+
+  // Phases over the four tile colours until every queue is empty.
+  void Grow(ThreadPool* pool) {
+    for (;;) {
+      bool any = false;
+      for (size_t t = 0; t < queues_.size() && !any; ++t)
+        any = !queues_[t].empty();
+      if (!any) break;
+      for (int colour = 0; colour < 4; ++colour) {
+        std::vector<int> active;
+        for (int t = 0; t < ntx_ * nty_; ++t) {
+          const int cx = t % ntx_, cy = t / ntx_;
+          if ((cx % 2) + 2 * (cy % 2) == colour && !queues_[t].empty())
+            active.push_back(t);
+        }
+        if (active.empty()) continue;
+        ++stats_.phases;
+        stats_.cpu_seconds += RunParallel(pool, static_cast<int>(active.size()),
+                                          [&](int i) { GrowTile(active[i]); });
+        MergeOutboxes(active);
+      }
+    }
+    for (long long v : visits_) stats_.pixel_visits += v;
+  }
+
+  const GrowStats& stats() const { return stats_; }
+
+ private:
+  static void Push(std::vector<Candidate>* q, const Candidate& c) {
+    q->push_back(c);
+    std::push_heap(q->begin(), q->end(), Lower());
+  }
+  int TileOf(int x, int y) const { return (y / T_) * ntx_ + (x / T_); }
+
+  // Whether a candidate of confidence conf may (re)visit pixel p: always
+  // when p holds nothing, else only when it beats p's confidence by more
+  // than the margin.
+  bool WorthVisit(int p, float conf) const {
+    const float have = cmap_[p];
+    return !(have > 0) || (have < conf && conf - have > margin_);
+  }
+
+  // Beyond the paper: when MPGC from the copied plane fails at (x, y), the
+  // planes of p's reconstructed 4-neighbours and perturbations of the
+  // copied plane are scored with the cheap NCC (no optimisation), and MPGC
+  // runs again from the best `hypotheses` of them that score above kappa.
+  bool MatchFromHypotheses(PatchMatcher* m, int x, int y, const Candidate& c,
+                           PatchResult* r, long long* visits) {
+    struct Hyp {
+      double score;
+      double depth;
+      Eigen::Vector3d n;
+    };
+    Hyp hyps[16];
+    int nh = 0;
+    const Eigen::Vector3d cn(c.normal[0], c.normal[1], c.normal[2]);
+    auto add = [&](double depth, const Eigen::Vector3d& n) {
+      if (nh >= 16 || !(depth > 0) || !std::isfinite(depth)) return;
+      const double score = m->PlaneScore(x, y, depth, n, 2);
+      if (score > min_score_) hyps[nh++] = {score, depth, n};
+    };
+    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    for (int k = 0; k < 4; ++k) {
+      const int nx = x + dx[k], ny = y + dy[k];
+      if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
+      const int q = ny * W_ + nx;
+      if (!(dmap_[q] > 0)) continue;
+      const Eigen::Vector3d nq(nmap_[3 * q], nmap_[3 * q + 1],
+                               nmap_[3 * q + 2]);
+      const Eigen::Vector3d Xq =
+          cam_.BackprojectCam(Eigen::Vector2d(nx + 0.5, ny + 0.5), dmap_[q]);
+      add(PlaneDepthAt(cam_, x, y, Xq, nq, dmap_[q]), nq);
+    }
+    // Perturbations: depth +-1 % and the normal tilted by 15 degrees about
+    // the image axes (deterministic: no random numbers).
+    for (double f : {0.99, 1.01}) add(c.depth * f, cn);
+    const double a = 15 * M_PI / 180;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d axis =
+          k < 2 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+      const Eigen::Vector3d n = Eigen::AngleAxisd(k % 2 ? a : -a, axis) * cn;
+      if (n.z() < -0.2) add(c.depth, n);
+    }
+    std::sort(hyps, hyps + nh,
+              [](const Hyp& u, const Hyp& v) { return u.score > v.score; });
+    for (int i = 0; i < std::min(nh, opt_.hypotheses); ++i) {
+      ++*visits;
+      if (m->Match(x, y, hyps[i].depth, hyps[i].n, r)) return true;
+    }
+    return false;
+  }
+
+  // Best-first growth inside one tile: pop, match, store, push the four
+  // neighbours with the same plane (those of other tiles to this tile's
+  // outbox).
+  void GrowTile(int tile) {
+    auto m = matchers_.Acquire();
+    const int tx0 = (tile % ntx_) * T_, ty0 = (tile / ntx_) * T_;
+    const int tx1 = std::min(W_, tx0 + T_), ty1 = std::min(H_, ty0 + T_);
+    auto& q = queues_[tile];
+    auto& out = outbox_[tile];
+    PatchResult r;
+    while (!q.empty()) {
+      std::pop_heap(q.begin(), q.end(), Lower());
+      const Candidate c = q.back();
+      q.pop_back();
+      const int p = c.pixel;
+      if (!WorthVisit(p, c.conf)) continue;
+      const int x = p % W_, y = p / W_;
+      ++visits_[tile];
+      if (!m->Match(x, y, c.depth,
+                    Eigen::Vector3d(c.normal[0], c.normal[1], c.normal[2]),
+                    &r) &&
+          !(opt_.hypotheses > 0 && !(cmap_[p] > 0) &&
+            MatchFromHypotheses(m.get(), x, y, c, &r, &visits_[tile])))
+        continue;
+      if (!(r.confidence > cmap_[p])) continue;
+      const float conf = static_cast<float>(r.confidence);
+      cmap_[p] = conf;
+      dmap_[p] = static_cast<float>(r.depth);
+      for (int k = 0; k < 3; ++k)
+        nmap_[3 * p + k] = static_cast<float>(r.normal[k]);
+      const Eigen::Vector3d X0 =
+          cam_.BackprojectCam(Eigen::Vector2d(x + 0.5, y + 0.5), r.depth);
+      static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+      for (int k = 0; k < 4; ++k) {
+        const int nx = x + dx[k], ny = y + dy[k];
+        if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
+        const int np = ny * W_ + nx;
+        if (!WorthVisit(np, conf)) continue;
+        if (mmap_ && !mmap_[np]) continue;
+        if (!m->WindowInside(nx, ny)) continue;
+        Candidate nc;
+        nc.conf = conf;
+        nc.pixel = np;
+        nc.depth = static_cast<float>(
+            PlaneDepthAt(cam_, nx, ny, X0, r.normal, r.depth));
+        for (int j = 0; j < 3; ++j)
+          nc.normal[j] = static_cast<float>(r.normal[j]);
+        if (nx >= tx0 && nx < tx1 && ny >= ty0 && ny < ty1) {
+          Push(&q, nc);
+        } else {
+          out.push_back(nc);
+        }
+      }
+    }
+    matchers_.Release(std::move(m));
+  }
+
+  // Hands the candidates for other tiles over, in tile order
+  // (deterministic).
+  void MergeOutboxes(const std::vector<int>& tiles) {
+    for (int t : tiles) {
+      for (const Candidate& c : outbox_[t])
+        Push(&queues_[TileOf(c.pixel % W_, c.pixel / W_)], c);
+      outbox_[t].clear();
+    }
+  }
+
+  const PatchContext& ctx_;
+  const Camera& cam_;
+  const RegionGrowingOptions& opt_;
+  MatcherPool matchers_;
+  const int W_, H_, T_, ntx_, nty_;
+  std::vector<std::vector<Candidate>> queues_, outbox_;
+  std::vector<long long> visits_;
+  const float margin_;
+  const double min_score_;
+  cv::Mat mask_;
+  const uint8_t* mmap_ = nullptr;
+  float* dmap_ = nullptr;
+  float* nmap_ = nullptr;
+  float* cmap_ = nullptr;
+  GrowStats stats_;
+};
+
+}  // namespace
+
 void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
                  const LocalViewSelectionOptions& local,
                  const RegionGrowingOptions& options,
@@ -119,158 +378,12 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
   Require(mask.empty() ||
               (mask.cols == W && mask.rows == H && mask.type() == CV_8U),
           "GrowRegions: mask must be CV_8U ", W, "x", H);
-  float* dmap = depth->ptr<float>();
-  float* nmap = normal->ptr<float>();
-  float* cmap = confidence->ptr<float>();
-  cv::Mat mask_c;
-  if (!mask.empty()) mask_c = mask.isContinuous() ? mask : mask.clone();
-  const uint8_t* mmap = mask_c.empty() ? nullptr : mask_c.ptr<uint8_t>();
-
-  MatcherPool matchers(context, mpgc, local);
-  GrowStats st;
-
-  const int T = options.tile_size;
-  const int ntx = (W + T - 1) / T, nty = (H + T - 1) / T;
-  const int ntiles = ntx * nty;
-  auto tile_of = [&](int x, int y) { return (y / T) * ntx + (x / T); };
-  std::vector<std::vector<Candidate>> queues(ntiles), outbox(ntiles);
-  std::vector<long long> visits(ntiles, 0);
-
-  // Seeds: matched fronto-parallel, in parallel; successes fill the queues
-  // in seed order.
-  const Eigen::Vector3d fronto(0, 0, -1);
-  std::vector<int> seed_ok(seeds.size(), 0);
-  std::vector<PatchResult> seed_res(seeds.size());
-  {
-    auto probe = matchers.Acquire();
-    for (size_t i = 0; i < seeds.size(); ++i) {
-      const Seed& s = seeds[i];
-      if (s.x < 0 || s.y < 0 || s.x >= W || s.y >= H) continue;
-      if (mmap && !mmap[s.y * W + s.x]) continue;
-      if (!probe->WindowInside(s.x, s.y) || !(s.depth > 0)) continue;
-      seed_ok[i] = 1;
-      ++st.seeds_tried;
-    }
-    matchers.Release(std::move(probe));
-  }
-  const int chunk = 64;
-  const int nchunks = static_cast<int>((seeds.size() + chunk - 1) / chunk);
-  st.cpu_seconds += RunParallel(pool, nchunks, [&](int ci) {
-    auto m = matchers.Acquire();
-    const size_t end =
-        std::min(seeds.size(), static_cast<size_t>(ci + 1) * chunk);
-    for (size_t i = static_cast<size_t>(ci) * chunk; i < end; ++i) {
-      if (!seed_ok[i]) continue;
-      if (!m->Match(seeds[i].x, seeds[i].y, seeds[i].depth, fronto,
-                    &seed_res[i]))
-        seed_ok[i] = 0;
-    }
-    matchers.Release(std::move(m));
-  });
-  st.pixel_visits += st.seeds_tried;
-  for (size_t i = 0; i < seeds.size(); ++i) {
-    if (!seed_ok[i]) continue;
-    ++st.seeds_accepted;
-    const PatchResult& r = seed_res[i];
-    Candidate c;
-    c.conf = static_cast<float>(r.confidence);
-    c.pixel = seeds[i].y * W + seeds[i].x;
-    c.depth = static_cast<float>(r.depth);
-    for (int k = 0; k < 3; ++k) c.normal[k] = static_cast<float>(r.normal[k]);
-    auto& q = queues[tile_of(seeds[i].x, seeds[i].y)];
-    q.push_back(c);
-    std::push_heap(q.begin(), q.end(), Lower());
-  }
-
-  const Camera& cam = context.ref_camera;
-  // Whether a candidate of confidence conf may (re)visit pixel p: always
-  // when p holds nothing, else only when it beats p's confidence by more
-  // than the margin (given in NCC units; confidence = (NCC + 1) / 2).
-  const float margin = static_cast<float>(0.5 * options.revisit_margin);
-  auto worth_visit = [&](int p, float conf) {
-    const float have = cmap[p];
-    return !(have > 0) || (have < conf && conf - have > margin);
-  };
-  auto process_tile = [&](int tile) {
-    auto m = matchers.Acquire();
-    const int tx0 = (tile % ntx) * T, ty0 = (tile / ntx) * T;
-    const int tx1 = std::min(W, tx0 + T), ty1 = std::min(H, ty0 + T);
-    auto& q = queues[tile];
-    auto& out = outbox[tile];
-    PatchResult r;
-    while (!q.empty()) {
-      std::pop_heap(q.begin(), q.end(), Lower());
-      const Candidate c = q.back();
-      q.pop_back();
-      const int p = c.pixel;
-      if (!worth_visit(p, c.conf)) continue;
-      const int x = p % W, y = p / W;
-      ++visits[tile];
-      if (!m->Match(x, y, c.depth,
-                    Eigen::Vector3d(c.normal[0], c.normal[1], c.normal[2]), &r))
-        continue;
-      if (!(r.confidence > cmap[p])) continue;
-      const float conf = static_cast<float>(r.confidence);
-      cmap[p] = conf;
-      dmap[p] = static_cast<float>(r.depth);
-      for (int k = 0; k < 3; ++k)
-        nmap[3 * p + k] = static_cast<float>(r.normal[k]);
-      const Eigen::Vector3d X0 =
-          cam.BackprojectCam(Eigen::Vector2d(x + 0.5, y + 0.5), r.depth);
-      static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
-      for (int k = 0; k < 4; ++k) {
-        const int nx = x + dx[k], ny = y + dy[k];
-        if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
-        const int np = ny * W + nx;
-        if (!worth_visit(np, conf)) continue;
-        if (mmap && !mmap[np]) continue;
-        if (!m->WindowInside(nx, ny)) continue;
-        Candidate nc;
-        nc.conf = conf;
-        nc.pixel = np;
-        nc.depth = static_cast<float>(
-            PlaneDepthAt(cam, nx, ny, X0, r.normal, r.depth));
-        for (int j = 0; j < 3; ++j)
-          nc.normal[j] = static_cast<float>(r.normal[j]);
-        if (nx >= tx0 && nx < tx1 && ny >= ty0 && ny < ty1) {
-          q.push_back(nc);
-          std::push_heap(q.begin(), q.end(), Lower());
-        } else {
-          out.push_back(nc);
-        }
-      }
-    }
-    matchers.Release(std::move(m));
-  };
-
-  for (;;) {
-    bool any = false;
-    for (int t = 0; t < ntiles && !any; ++t) any = !queues[t].empty();
-    if (!any) break;
-    for (int colour = 0; colour < 4; ++colour) {
-      std::vector<int> active;
-      for (int t = 0; t < ntiles; ++t) {
-        const int cx = t % ntx, cy = t / ntx;
-        if ((cx % 2) + 2 * (cy % 2) == colour && !queues[t].empty())
-          active.push_back(t);
-      }
-      if (active.empty()) continue;
-      ++st.phases;
-      st.cpu_seconds += RunParallel(pool, static_cast<int>(active.size()),
-                                    [&](int i) { process_tile(active[i]); });
-      // Merge the outboxes in tile order (deterministic).
-      for (int t : active) {
-        for (const Candidate& c : outbox[t]) {
-          auto& q = queues[tile_of(c.pixel % W, c.pixel / W)];
-          q.push_back(c);
-          std::push_heap(q.begin(), q.end(), Lower());
-        }
-        outbox[t].clear();
-      }
-    }
-  }
-  for (long long v : visits) st.pixel_visits += v;
+  RegionGrower grower(context, mpgc, local, options, mask, depth, normal,
+                      confidence);
+  grower.SeedQueues(seeds, pool);
+  grower.Grow(pool);
   if (stats) {
+    const GrowStats& st = grower.stats();
     stats->seeds_tried += st.seeds_tried;
     stats->seeds_accepted += st.seeds_accepted;
     stats->pixel_visits += st.pixel_visits;
@@ -297,6 +410,13 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "stored one by more than this, NCC units (paper: 0)")
       .Min(0)
       .Max(2);
+  registry
+      ->Add(key("hypotheses"), &o->hypotheses,
+            "when MPGC from the copied plane fails at an empty pixel, try "
+            "this many alternative planes (neighbours', perturbed) ranked by "
+            "NCC; 0 = paper")
+      .Min(0)
+      .Max(16);
 }
 
 }  // namespace wild_mvs

@@ -34,6 +34,13 @@ struct RegionGrowingOptions {
   // the MPGC runs were revisits, 91 % of the successful ones improved the
   // mean NCC by less than 0.1).
   double revisit_margin = 0.1;
+  // (beyond the paper, as PatchMatch-style systems do) When MPGC from the
+  // plane copied from the popped neighbour fails at a pixel that holds
+  // nothing yet, the planes of its reconstructed 4-neighbours and
+  // perturbations of the copied plane (depth +-1 %, normal +-15 degrees)
+  // are scored with the NCC of the unoptimised window and MPGC runs from
+  // the best this many of them (scoring above mpgc.drop_ncc). 0 = paper.
+  int hypotheses = 0;
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h), e.g. "mvs.growing".
