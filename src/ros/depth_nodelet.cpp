@@ -29,10 +29,10 @@
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/ros/conversions.h"
-#include "wild_mvs/ros/drop_counter.h"
 #include "wild_mvs/ros/params_ros.h"
-#include "wild_mvs/ros/stream_reconstructor.h"
 #include "wild_mvs/ros/undistorter.h"
+#include "wild_mvs/stream/drop_counter.h"
+#include "wild_mvs/stream/stream_reconstructor.h"
 
 namespace wild_mvs {
 namespace ros1 {

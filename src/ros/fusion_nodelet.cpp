@@ -25,10 +25,10 @@
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/io/depth_map_io.h"
-#include "wild_mvs/ros/cloud_file.h"
 #include "wild_mvs/ros/conversions.h"
-#include "wild_mvs/ros/drop_counter.h"
 #include "wild_mvs/ros/params_ros.h"
+#include "wild_mvs/stream/cloud_file.h"
+#include "wild_mvs/stream/drop_counter.h"
 #if __has_include("wild_mvs/core/meshing.h")
 #include "wild_mvs/core/meshing.h"
 #define WILD_MVS_HAVE_MESHING 1
