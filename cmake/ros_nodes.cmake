@@ -1,5 +1,5 @@
-# ROS 1 targets: the ROS layer library (conversions, parameters, keyframe
-# store, stream reconstructor, nodelets), node executables, the bag
+# ROS 1 targets: the ROS layer library (conversions, parameters, nodelets
+# over the ROS-free wild_mvs_stream), node executables, the bag
 # converter, and the ROS tests. Included at the end of the top-level
 # CMakeLists.txt when WILD_MVS_WITH_ROS is ON (after cmake/ros_setup.cmake).
 #
@@ -14,7 +14,7 @@ target_include_directories(wild_mvs_ros PUBLIC
   $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
   ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
 target_include_directories(wild_mvs_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
-target_link_libraries(wild_mvs_ros PUBLIC wild_mvs_io ${catkin_LIBRARIES})
+target_link_libraries(wild_mvs_ros PUBLIC wild_mvs_stream ${catkin_LIBRARIES})
 target_compile_options(wild_mvs_ros PRIVATE ${WILD_MVS_WARNINGS})
 add_dependencies(wild_mvs_ros ${PROJECT_NAME}_generate_messages_cpp
   ${catkin_EXPORTED_TARGETS})
@@ -45,9 +45,9 @@ endif()
 # --- install space -------------------------------------------------------------
 # `cmake --install build --prefix P` gives a self-contained catkin install
 # space (source P/setup.bash; rosrun / roslaunch / nodelet from there). The
-# core and io libraries are static and PIC, linked into libwild_mvs_ros.so,
-# the nodes and the CLI; they and the headers are installed for packages
-# that build on wild_mvs (catkin_package LIBRARIES).
+# core, io and stream libraries are static and PIC, linked into
+# libwild_mvs_ros.so, the nodes and the CLI; they and the headers are
+# installed for packages that build on wild_mvs (catkin_package LIBRARIES).
 # The installed binaries are relocatable: the nodes and tools
 # (lib/wild_mvs/ of the devel or install space) and the libraries (lib/)
 # find the project's libraries in lib/ through $ORIGIN, the same way in the
@@ -55,12 +55,12 @@ endif()
 # time, which fails on catkin's build RPATH). Tests and fuzz harnesses keep
 # CMake's build RPATH.
 set(WILD_MVS_INSTALLED_TARGETS ${WILD_MVS_ROS_EXECUTABLES} wild_mvs wild_mvs_ros
-  wild_mvs_core wild_mvs_io)
+  wild_mvs_core wild_mvs_io wild_mvs_stream)
 set_target_properties(${WILD_MVS_INSTALLED_TARGETS} PROPERTIES
   BUILD_WITH_INSTALL_RPATH ON INSTALL_RPATH "$ORIGIN/..;$ORIGIN/../lib")
 install(TARGETS ${WILD_MVS_ROS_EXECUTABLES}
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
-install(TARGETS wild_mvs_ros wild_mvs_core wild_mvs_io
+install(TARGETS wild_mvs_ros wild_mvs_core wild_mvs_io wild_mvs_stream
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   RUNTIME DESTINATION ${CATKIN_GLOBAL_BIN_DESTINATION})

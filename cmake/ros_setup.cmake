@@ -50,7 +50,7 @@ generate_messages(DEPENDENCIES std_msgs sensor_msgs geometry_msgs)
 
 catkin_package(
   INCLUDE_DIRS include
-  LIBRARIES wild_mvs_core wild_mvs_io wild_mvs_ros
+  LIBRARIES wild_mvs_core wild_mvs_io wild_mvs_stream wild_mvs_ros
   CATKIN_DEPENDS roscpp nodelet std_msgs std_srvs sensor_msgs geometry_msgs
     visualization_msgs diagnostic_msgs diagnostic_updater image_transport
     tf2 tf2_ros tf2_msgs rosbag message_runtime)

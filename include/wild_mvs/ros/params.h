@@ -25,7 +25,7 @@
 
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/option_registry.h"
-#include "wild_mvs/ros/stream_reconstructor.h"
+#include "wild_mvs/stream/stream_reconstructor.h"
 
 namespace wild_mvs {
 namespace ros1 {

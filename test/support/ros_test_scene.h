@@ -1,7 +1,7 @@
-// Copyright wild_mvs authors. The synthetic stream shared by the ROS tests:
-// boxes and a sphere on a textured ground plane, seen by cameras moving in
-// 10-degree steps on an arc (a robot circling an object), small images so
-// the tests stay fast.
+// Copyright wild_mvs authors. The synthetic stream shared by the stream and
+// ROS tests: boxes and a sphere on a textured ground plane, seen by cameras
+// moving in 10-degree steps on an arc (a robot circling an object), small
+// images so the tests stay fast.
 #pragma once
 
 #include "synthetic_scene.h"

@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors.
-#include "wild_mvs/ros/stream_reconstructor.h"
+#include "wild_mvs/stream/stream_reconstructor.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,13 +10,19 @@
 #include "wild_mvs/core/global_view_selection.h"
 
 namespace wild_mvs {
-namespace ros1 {
 
 namespace {
 double WallSeconds() {
   return std::chrono::duration<double>(
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
+}
+
+// Seconds for the stream's timing rules (the exact stamp is kept for the
+// outputs).
+double StampSeconds(uint64_t stamp_ns) {
+  return static_cast<double>(stamp_ns / 1000000000ull) +
+         static_cast<double>(stamp_ns % 1000000000ull) * 1e-9;
 }
 }  // namespace
 
@@ -108,9 +114,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
 StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     uint64_t stamp_ns, const std::string& frame_id, const Camera& camera,
     const cv::Mat& image) {
-  // Seconds for the stream's timing rules; the exact stamp for the outputs.
-  const double stamp = static_cast<double>(stamp_ns / 1000000000ull) +
-                       static_cast<double>(stamp_ns % 1000000000ull) * 1e-9;
+  const double stamp = StampSeconds(stamp_ns);
   camera.Validate("frame '" + frame_id + "'");
   Require(image.type() == CV_32FC3, "frame '", frame_id,
           "': image must be CV_32FC3");
@@ -194,6 +198,13 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
   std::lock_guard<std::mutex> lock(mutex_);
   ScheduleLocked();
   return status;
+}
+
+bool StreamReconstructor::IsOutOfOrder(uint64_t stamp_ns) const {
+  const double stamp = StampSeconds(stamp_ns);
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_stamp_ >= 0 && stamp <= last_stamp_ &&
+         last_stamp_ - stamp <= options_.stamp_reset_threshold;
 }
 
 void StreamReconstructor::SetSparsePoints(
@@ -436,5 +447,4 @@ int StreamReconstructor::GoodNeighbors(uint32_t id) const {
   return 0;
 }
 
-}  // namespace ros1
 }  // namespace wild_mvs

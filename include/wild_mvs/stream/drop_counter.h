@@ -9,7 +9,6 @@
 #include <string>
 
 namespace wild_mvs {
-namespace ros1 {
 
 class DropCounter {
  public:
@@ -35,5 +34,4 @@ class DropCounter {
   std::map<std::string, Entry> entries_;
 };
 
-}  // namespace ros1
 }  // namespace wild_mvs

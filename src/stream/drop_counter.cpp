@@ -1,8 +1,7 @@
 // Copyright wild_mvs authors.
-#include "wild_mvs/ros/drop_counter.h"
+#include "wild_mvs/stream/drop_counter.h"
 
 namespace wild_mvs {
-namespace ros1 {
 
 bool DropCounter::Count(const std::string& reason, uint64_t* count) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -33,5 +32,4 @@ uint64_t DropCounter::Total() const {
   return n;
 }
 
-}  // namespace ros1
 }  // namespace wild_mvs

@@ -8,10 +8,9 @@
 #include "ros_test_scene.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/metrics.h"
-#include "wild_mvs/ros/stream_reconstructor.h"
+#include "wild_mvs/stream/stream_reconstructor.h"
 
 namespace wild_mvs {
-namespace ros1 {
 namespace {
 
 using testing::SyntheticScene;
@@ -177,7 +176,12 @@ TEST(StreamReconstructor, KeyframeSelectionOrderAndResets) {
   EXPECT_EQ(stream.Stats().session, 10.0);  // the first frame starts it
   // Same pose again: not a keyframe.
   EXPECT_EQ(stream.AddFrame(10.1, "cam", c0, s.images[0]), S::kNotKeyframe);
-  // Older stamp (small step back): out of order, dropped.
+  // Older stamp (small step back): out of order, dropped; IsOutOfOrder
+  // tells before (the node skips converting such frames).
+  EXPECT_TRUE(stream.IsOutOfOrder(10050000000ull));
+  EXPECT_TRUE(stream.IsOutOfOrder(10100000000ull));   // the same stamp
+  EXPECT_FALSE(stream.IsOutOfOrder(10100000001ull));  // later
+  EXPECT_FALSE(stream.IsOutOfOrder(1000000000ull));   // far back: a reset
   EXPECT_EQ(stream.AddFrame(10.05, "cam", s.scene.views[1].camera, s.images[1]),
             S::kOutOfOrder);
   EXPECT_EQ(stream.AddFrame(10.2, "cam", s.scene.views[1].camera, s.images[1]),
@@ -234,5 +238,4 @@ TEST(StreamReconstructor, OptionsAreChecked) {
 }
 
 }  // namespace
-}  // namespace ros1
 }  // namespace wild_mvs

@@ -4,10 +4,9 @@
 #include <cmath>
 
 #include "wild_mvs/core/error.h"
-#include "wild_mvs/ros/keyframe_store.h"
+#include "wild_mvs/stream/keyframe_store.h"
 
 namespace wild_mvs {
-namespace ros1 {
 namespace {
 
 // Camera at centre (x, 0, 0) looking along +z, rotated by yaw_deg about y.
@@ -109,5 +108,4 @@ TEST(KeyframeStore, OptionsAreChecked) {
 }
 
 }  // namespace
-}  // namespace ros1
 }  // namespace wild_mvs

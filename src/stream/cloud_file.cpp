@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors.
-#include "wild_mvs/ros/cloud_file.h"
+#include "wild_mvs/stream/cloud_file.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -9,7 +9,6 @@
 #include "wild_mvs/io/atomic_file.h"
 
 namespace wild_mvs {
-namespace ros1 {
 
 void SaveCloudPly(const std::string& path, const PointCloud& cloud) {
   Require(!path.empty(), "SaveCloudPly: empty path");
@@ -45,5 +44,4 @@ void SaveCloudPly(const std::string& path, const PointCloud& cloud) {
   });
 }
 
-}  // namespace ros1
 }  // namespace wild_mvs

@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "test_paths.h"
-#include "wild_mvs/ros/cloud_file.h"
+#include "wild_mvs/stream/cloud_file.h"
 
 namespace wild_mvs {
 namespace testing {
@@ -57,7 +57,7 @@ std::vector<fs::path> TempFiles(const fs::path& path) {
 TEST(CloudFile, SavesAValidBinaryPly) {
   const std::string dir = MakeTempDir("wild_mvs_cloud_file");
   const std::string path = dir + "/cloud.ply";
-  ros1::SaveCloudPly(path, MakeCloud(10));
+  SaveCloudPly(path, MakeCloud(10));
   const std::string s = ReadAll(path);
   const size_t end = s.find("end_header\n");
   ASSERT_NE(end, std::string::npos);
@@ -71,7 +71,7 @@ TEST(CloudFile, SavesAValidBinaryPly) {
 TEST(CloudFile, SigkillDuringSaveLeavesThePreviousFileIntact) {
   const std::string dir = MakeTempDir("wild_mvs_cloud_file_kill");
   const std::string path = dir + "/cloud.ply";
-  ros1::SaveCloudPly(path, MakeCloud(1000));
+  SaveCloudPly(path, MakeCloud(1000));
   const std::string before = ReadAll(path);
   ASSERT_GT(before.size(), 1000u);
   // A cloud of 4 M points (~124 MB of PLY) takes long enough to write that
@@ -81,7 +81,7 @@ TEST(CloudFile, SigkillDuringSaveLeavesThePreviousFileIntact) {
   ASSERT_GE(child, 0);
   if (child == 0) {
     try {
-      ros1::SaveCloudPly(path, big);
+      SaveCloudPly(path, big);
     } catch (...) {
       _exit(2);
     }
@@ -119,7 +119,7 @@ TEST(CloudFile, SigkillDuringSaveLeavesThePreviousFileIntact) {
   ASSERT_EQ(temps.size(), 1u);
   EXPECT_LT(fs::file_size(temps[0]), 4000000u * 31u);
   // The next save succeeds and replaces it.
-  ros1::SaveCloudPly(path, MakeCloud(20));
+  SaveCloudPly(path, MakeCloud(20));
   EXPECT_NE(ReadAll(path).find("element vertex 20\n"), std::string::npos);
   fs::remove_all(dir);
 }

@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors.
-#include "wild_mvs/ros/keyframe_store.h"
+#include "wild_mvs/stream/keyframe_store.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,6 @@
 #include "wild_mvs/core/error.h"
 
 namespace wild_mvs {
-namespace ros1 {
 
 size_t Keyframe::Bytes() const {
   return image.empty() ? 0 : image.total() * image.elemSize();
@@ -124,5 +123,4 @@ void KeyframeStore::Clear() {
   bytes_ = 0;
 }
 
-}  // namespace ros1
 }  // namespace wild_mvs

@@ -28,7 +28,6 @@
 #include "wild_mvs/core/camera.h"
 
 namespace wild_mvs {
-namespace ros1 {
 
 struct Keyframe {
   uint32_t id = 0;
@@ -90,5 +89,4 @@ class KeyframeStore {
   size_t bytes_ = 0;
 };
 
-}  // namespace ros1
 }  // namespace wild_mvs

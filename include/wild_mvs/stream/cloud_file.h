@@ -6,7 +6,6 @@
 #include "wild_mvs/core/point_cloud.h"
 
 namespace wild_mvs {
-namespace ros1 {
 
 // Writes `cloud` as a binary little-endian PLY (x y z float; nx ny nz float,
 // red green blue uchar, confidence float when present) atomically: a
@@ -15,5 +14,4 @@ namespace ros1 {
 // path and the problem.
 void SaveCloudPly(const std::string& path, const PointCloud& cloud);
 
-}  // namespace ros1
 }  // namespace wild_mvs

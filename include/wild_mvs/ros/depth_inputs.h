@@ -1,0 +1,115 @@
+// Copyright wild_mvs authors. The depth node's inputs: the subscriptions
+// (image through image_transport or the compressed fallback, camera_info,
+// pose, sparse_points) and the conversion of a received image into what
+// the StreamReconstructor takes: camera_info paired by stamp, pixels decoded
+// to linear RGB and undistorted, pose from tf2 or the pose topic (waits in
+// wall time). Every failure drops the frame through the node's drop
+// callback (counted, throttled) naming the topic and the problem.
+#pragma once
+
+#include <geometry_msgs/PoseStamped.h>
+#include <image_transport/image_transport.h>
+#include <ros/node_handle.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <wild_mvs/SparsePoints.h>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "wild_mvs/core/camera.h"
+#include "wild_mvs/ros/params.h"
+#include "wild_mvs/ros/undistorter.h"
+#include "wild_mvs/stream/stamp_buffer.h"
+#include "wild_mvs/stream/stream_reconstructor.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+// A received image (raw or compressed), before conversion.
+struct DepthFrame {
+  sensor_msgs::ImageConstPtr raw;
+  sensor_msgs::CompressedImageConstPtr compressed;
+  sensor_msgs::CameraInfoConstPtr info;  // set by PairCameraInfo
+  ros::Time stamp;
+  std::string frame_id;
+};
+
+class DepthInputs {
+ public:
+  // topic, problem, detail
+  using DropFn = std::function<void(const std::string&, const std::string&,
+                                    const std::string&)>;
+  using FrameFn = std::function<void(DepthFrame)>;
+  using PointsFn =
+      std::function<void(std::vector<StreamReconstructor::StampedPoint>)>;
+
+  // `options` (the node's, outliving this) are read when used, so that the
+  // node may strip the frames' '/' with NoSlash after construction.
+  DepthInputs(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
+              const DepthNodeOptions& options, DropFn drop);
+  // Subscribes: images go to on_frame, sparse points (sparse_source
+  // "topic") to on_points, both on the callback threads. Throws Error when
+  // the image_transport plugin is not installed.
+  void Subscribe(FrameFn on_frame, PointsFn on_points);
+  // Ends the waits (for good) and unsubscribes the images and points.
+  void Stop();
+
+  // The camera's optical frame (~camera_frame, else the image's) and the
+  // camera_info of the frame's stamp (or the latest): false when none came
+  // within tf_timeout.
+  bool PairCameraInfo(DepthFrame* f);
+  // Camera (intrinsics and pose) and undistorted linear RGB image of a
+  // paired frame; false when the frame is dropped.
+  bool Convert(const DepthFrame& f, Camera* cam, cv::Mat* image);
+
+  // The topic a frame came on (for messages) and the resolved inputs.
+  std::string ImageTopic(const DepthFrame& f) const;
+  std::string Topic(const std::string& name) const;
+  const std::string& image_topic() const { return image_topic_; }
+  const std::string& info_topic() const { return info_topic_; }
+  bool rectified() const { return rectified_; }
+  // A frame id as tf2 wants it: without leading '/' (tf2 rejects them, and
+  // many recorded bags have them); warns once per frame id.
+  std::string NoSlash(const std::string& frame_id);
+
+ private:
+  bool LookupPose(const DepthFrame& f, Camera* cam);
+  void OnRaw(const sensor_msgs::ImageConstPtr& msg);
+  void OnCompressed(const sensor_msgs::CompressedImageConstPtr& msg);
+  void OnInfo(const sensor_msgs::CameraInfoConstPtr& msg);
+  void OnPose(const geometry_msgs::PoseStampedConstPtr& msg);
+  void OnSparsePoints(const wild_mvs::SparsePointsConstPtr& msg);
+
+  ros::NodeHandle nh_, pnh_;
+  const DepthNodeOptions& options_;
+  DropFn drop_;
+  FrameFn on_frame_;
+  PointsFn on_points_;
+  std::string image_topic_, info_topic_;      // resolved input names
+  bool rectified_ = false;                    // camera from P, D ignored
+  std::unique_ptr<Undistorter> undistorter_;  // front end only
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<image_transport::ImageTransport> it_;
+  image_transport::Subscriber image_sub_;
+  ros::Subscriber compressed_sub_, info_sub_, pose_sub_, points_sub_;
+  // camera_infos by exact stamp (ns) and poses of the pose topic.
+  ExactStampBuffer<sensor_msgs::CameraInfoConstPtr> infos_{100};
+  NearestStampBuffer<geometry_msgs::PoseStampedConstPtr> poses_{500};
+  std::atomic<bool> stopping_{false};
+  std::mutex slash_mutex_;
+  std::set<std::string> slash_warned_;  // frame ids warned about once
+};
+
+}  // namespace ros1
+}  // namespace wild_mvs

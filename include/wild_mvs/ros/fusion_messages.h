@@ -1,0 +1,31 @@
+// Copyright wild_mvs authors. The fusion node's messages around the
+// ROS-free FusionSession: a DepthView decoded into a FusionView, the node's
+// options as session options, and its diagnostics.
+#pragma once
+
+#include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <wild_mvs/DepthView.h>
+
+#include <cstddef>
+#include <cstdint>
+
+#include "wild_mvs/ros/params.h"
+#include "wild_mvs/stream/drop_counter.h"
+#include "wild_mvs/stream/fusion_session.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+// The view of a DepthView (depth map, image in linear RGB when it has the
+// map's size, keyframe id, session, stamps; `arrived` = now). Throws Error
+// for an invalid message.
+FusionView FusionViewFromMsg(const wild_mvs::DepthView& msg);
+
+FusionSessionOptions SessionOptions(const FusionNodeOptions& options);
+
+void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
+                           size_t queued, const DropCounter& drops,
+                           diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+}  // namespace ros1
+}  // namespace wild_mvs

@@ -1,0 +1,223 @@
+// Copyright wild_mvs authors. Multi-view stereo over a live stream of posed
+// frames (ROS-free; the depth node is a thin shell around it).
+//
+// AddFrame() selects keyframes (baseline / viewing-angle thresholds), keeps
+// them in a bounded KeyframeStore, grows the sparse tracks (the incremental
+// tracker, or points given with SetSparsePoints), and schedules the
+// reconstruction of every keyframe this worker owns (id % worker_count ==
+// worker_index) once it has enough good neighbours. Reconstructions run on
+// an internal worker pool: AddFrame never waits for them. A keyframe may be
+// redone later when its neighbourhood became clearly better
+// (redo_min_gain). Results are handed to the result callback on a worker
+// thread.
+//
+// Thread-safe: AddFrame / Tick / SetSparsePoints / Reset / Stats may be
+// called from any thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "wild_mvs/core/depth_map.h"
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/image.h"
+#include "wild_mvs/core/reconstruct_view.h"
+#include "wild_mvs/core/scene.h"
+#include "wild_mvs/core/sparse_tracker.h"
+#include "wild_mvs/core/thread_pool.h"
+#include "wild_mvs/stream/keyframe_store.h"
+
+namespace wild_mvs {
+
+struct StreamOptions {
+  KeyframeSelectionOptions keyframes;
+  KeyframeStoreOptions store;
+  // Threads inside one reconstruction (image tiles). Reconstructions run one
+  // at a time on a dispatcher thread, never on the caller's thread.
+  int num_threads = 2;   // config/depth_node.yaml shows the same
+  int max_pending = 2;   // reconstructions queued or running; more wait
+  int worker_index = 0;  // this worker owns keyframes with
+  int worker_count = 1;  // id % worker_count == worker_index
+  // Good neighbours of a keyframe = the views the core's global view
+  // selection (mvs.global) picks for it over the store with a positive
+  // score (shared sparse points, parallax and resolution weights).
+  // Good neighbours before reconstructing (at least
+  // mvs.mpgc.min_active_views, which MPGC needs).
+  int min_neighbors = 3;
+  // Reconstruct once `lookahead` later keyframes arrived (so neighbours on
+  // both sides exist) or after `idle_flush` s (wall time) without a new
+  // keyframe, or when mvs.global.num_neighbors good neighbours are there.
+  int lookahead = 2;
+  double idle_flush = 1.0;
+  // Redo a reconstructed keyframe when its neighbour score grew by this
+  // factor since (0 = never), at most max_redo times.
+  double redo_min_gain = 0.0;
+  int max_redo = 1;
+  // Longest image side used (input downscaled at arrival); 0 = as received.
+  int max_image_size = 0;
+  // A camera jump larger than this (metres) between consecutive frames less
+  // than 1 s apart is a pose reset (tracking lost, relocalised): the stream
+  // restarts (store and tracks cleared). 0 = never.
+  double max_pose_jump = 0.0;
+  double stamp_reset_threshold = 1.0;  // s, see AddFrame
+  bool use_tracker = true;  // false: sparse points come from SetSparsePoints
+  MvsOptions mvs;           // the core's per-view MVS options
+  TrackerOptions tracker;   // the incremental tracker (use_tracker)
+  void Check() const;
+};
+
+// One reconstructed keyframe.
+struct StreamResult {
+  uint32_t keyframe_id = 0;  // 0, 1, ... within the session
+  // Stamp of the first frame of the stream session the keyframe belongs to.
+  // A session starts with the first frame and again after every reset
+  // (time or pose jump, Reset()); keyframe ids restart at 0. Depth maps
+  // never use keyframes of another session. Workers fed the same stream
+  // agree on sessions and ids; a restarted node starts a new session.
+  double session = 0;
+  double stamp = 0;
+  // The same stamps, exact (ns since the epoch of the image header's
+  // ros::Time): outputs carry these bit for bit, never the doubles.
+  uint64_t session_ns = 0;
+  uint64_t stamp_ns = 0;
+  std::string frame_id;
+  int revision = 0;                          // 0 first time, then 1, 2 ...
+  std::vector<uint32_t> neighbor_ids;        // keyframe ids matched against
+  std::vector<double> neighbor_stamps;       // and their stamps
+  std::vector<uint64_t> neighbor_stamps_ns;  // exact (ns)
+  cv::Mat image;                             // the keyframe image (linear RGB)
+  DepthMap depth;                            // camera = keyframe camera at the
+                                             // depth map's resolution
+  double seconds = 0;                        // wall time of the reconstruction
+};
+
+struct StreamStats {
+  size_t keyframes = 0;  // held in the store
+  double store_mb = 0;
+  uint64_t frames = 0;           // frames given to AddFrame
+  uint64_t keyframes_total = 0;  // keyframes created
+  int pending = 0;               // reconstructions queued or running
+  int waiting = 0;               // ready keyframes waiting for a free slot
+  uint64_t reconstructed = 0;    // depth maps produced (incl. redone)
+  uint64_t redone = 0;
+  uint64_t failed = 0;           // reconstructions that threw
+  uint64_t evicted_waiting = 0;  // owned keyframes evicted before their
+                                 // depth map (store too small for the rate)
+  uint64_t stale_results = 0;    // results discarded after a Reset
+  uint64_t out_of_order = 0;     // frames with non-increasing stamps
+  uint64_t resets = 0;
+  double session = -1;  // stamp that started the current session (-1: none)
+  size_t sparse_points = 0;
+  // Memory of the online tracker (SparseTracker::bytes()): it keeps a few
+  // bytes per feature of every keyframe ever added, also after eviction.
+  double tracker_mb = 0;
+  double last_seconds = 0, mean_seconds = 0;  // per depth map
+};
+
+class StreamReconstructor {
+ public:
+  using ResultCallback = std::function<void(const StreamResult&)>;
+  using ErrorCallback = std::function<void(const std::string&)>;
+
+  StreamReconstructor(const StreamOptions& options, ResultCallback on_result,
+                      ErrorCallback on_error = nullptr);
+  ~StreamReconstructor();  // waits for running reconstructions
+
+  enum class FrameStatus {
+    kKeyframe,     // kept as a keyframe
+    kNotKeyframe,  // too close to the last keyframe
+    kOutOfOrder,   // stamp not after the previous frame's: dropped
+    kReset,        // pose or time jump: the stream restarted with it
+  };
+  // A new frame: camera (pose + intrinsics of `image`) and image (CV_32FC3
+  // linear RGB of the camera's size). Call from one thread at a time (the
+  // node's front end): the tracker runs here. A stamp more than
+  // stamp_reset_threshold s before the previous one resets the stream (bag
+  // loop, restarted clock); other stamps not after the previous one are
+  // kOutOfOrder. Throws Error on an invalid camera or image.
+  // `stamp_ns` is the image's exact stamp (ros::Time::toNSec()); the
+  // results carry it unchanged.
+  FrameStatus AddFrame(uint64_t stamp_ns, const std::string& frame_id,
+                       const Camera& camera, const cv::Mat& image);
+  // The same with a stamp in seconds (rounded to ns; tests and tools).
+  FrameStatus AddFrame(double stamp, const std::string& frame_id,
+                       const Camera& camera, const cv::Mat& image);
+  // True when AddFrame would return kOutOfOrder for a frame with this stamp
+  // (the node drops such frames before converting them).
+  bool IsOutOfOrder(uint64_t stamp_ns) const;
+  // Replaces the sparse points (use_tracker = false). Observations refer to
+  // frames by stamp; stamps that are not keyframes are ignored.
+  struct StampedObservation {
+    double stamp;
+    Eigen::Vector2d xy;  // core pixel convention; NaN = project
+  };
+  struct StampedPoint {
+    Eigen::Vector3d xyz;
+    std::vector<StampedObservation> observations;
+  };
+  void SetSparsePoints(const std::vector<StampedPoint>& points);
+  // Call periodically: flushes keyframes waiting longer than idle_flush.
+  void Tick();
+  // Forgets every keyframe and track (results of running reconstructions
+  // are discarded).
+  void Reset();
+  // Blocks until nothing is queued or running (tests, shutdown).
+  void WaitIdle();
+  StreamStats Stats() const;
+
+  // Good-neighbour count of keyframe `id` (tests).
+  int GoodNeighbors(uint32_t id) const;
+
+ private:
+  struct Neighborhood {
+    int good = 0;
+    double score = 0;
+  };
+  // The store as a Scene (view i = keyframes[i]) with the sparse points
+  // remapped to it.
+  struct Snapshot {
+    std::vector<KeyframePtr> keyframes;
+    Scene scene;
+    std::vector<std::vector<int>> points_per_view;
+  };
+  Snapshot MakeSnapshotLocked() const;
+  Neighborhood Evaluate(const Snapshot& snap, int index) const;
+  void ScheduleLocked();
+  void RunReconstruction(uint32_t id, uint64_t generation);
+  void ClearLocked();
+
+  StreamOptions options_;
+  ResultCallback on_result_;
+  ErrorCallback on_error_;
+  mutable std::mutex mutex_;
+  std::condition_variable idle_cv_;
+  KeyframeStore store_;
+  // Sparse points; Observation::view holds a keyframe id.
+  std::vector<SparsePoint> points_;
+  std::vector<StampedPoint> stamped_points_;  // SetSparsePoints
+  bool stopping_ = false;
+  std::unique_ptr<SparseTracker> tracker_;
+  std::set<uint32_t> in_flight_;  // queued or running
+  int ready_waiting_ = 0;
+  uint32_t next_id_ = 0;
+  uint64_t generation_ = 0;
+  double last_keyframe_wall_ = 0;  // steady clock, s
+  double last_stamp_ = -1;
+  double session_ = -1;  // see StreamResult::session
+  uint64_t session_ns_ = 0;
+  bool have_last_center_ = false;
+  Eigen::Vector3d last_center_{0, 0, 0};
+  StreamStats stats_;
+  double total_seconds_ = 0;
+  std::unique_ptr<ThreadPool> dispatcher_;  // one thread: reconstructions
+  std::unique_ptr<ThreadPool> inner_pool_;  // tiles inside one view
+};
+
+}  // namespace wild_mvs

@@ -1,0 +1,271 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/ros/depth_inputs.h"
+
+#include <image_transport/camera_common.h>
+#include <ros/console.h>
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/ros/conversions.h"
+#include "wild_mvs/ros/depth_messages.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+namespace {
+bool EndsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() &&
+         s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+}  // namespace
+
+DepthInputs::DepthInputs(const ros::NodeHandle& nh,
+                         const ros::NodeHandle& private_nh,
+                         const DepthNodeOptions& options, DropFn drop)
+    : nh_(nh), pnh_(private_nh), options_(options), drop_(std::move(drop)) {
+  // camera_info sits beside the image (image_transport's CameraSubscriber
+  // convention) unless `camera_info` is remapped itself.
+  image_topic_ = nh_.resolveName("image");
+  info_topic_ = nh_.resolveName("camera_info");
+  if (info_topic_ == nh_.resolveName("camera_info", false))
+    info_topic_ = image_transport::getCameraInfoTopic(image_topic_);
+  rectified_ = options_.rectified || EndsWith(image_topic_, "/image_rect") ||
+               EndsWith(image_topic_, "/image_rect_color");
+  undistorter_ = std::make_unique<Undistorter>(rectified_);
+}
+
+void DepthInputs::Subscribe(FrameFn on_frame, PointsFn on_points) {
+  on_frame_ = std::move(on_frame);
+  on_points_ = std::move(on_points);
+  const DepthNodeOptions& o = options_;
+  if (o.pose_source == "tf") {
+    tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(30.0));
+    tf_listener_ =
+        std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_, true);
+  } else {
+    pose_sub_ = nh_.subscribe("pose", 50, &DepthInputs::OnPose, this);
+  }
+  if (o.sparse_source == "topic")
+    points_sub_ =
+        nh_.subscribe("sparse_points", 2, &DepthInputs::OnSparsePoints, this);
+  info_sub_ = nh_.subscribe(info_topic_, 20, &DepthInputs::OnInfo, this);
+  it_ = std::make_unique<image_transport::ImageTransport>(nh_);
+  const std::vector<std::string> plugins = it_->getLoadableTransports();
+  const bool have_plugin = std::find(plugins.begin(), plugins.end(),
+                                     o.image_transport) != plugins.end();
+  if (o.image_transport == "raw" || have_plugin) {
+    image_sub_ = it_->subscribe(image_topic_, 5, &DepthInputs::OnRaw, this,
+                                image_transport::TransportHints(
+                                    o.image_transport, ros::TransportHints(),
+                                    pnh_, "image_transport_hints"));
+  } else if (o.image_transport == "compressed") {
+    // No compressed plugin installed (Debian 12 ships none): take
+    // <image>/compressed and decode it here. "image" is remapped as a
+    // whole name, so it is resolved before appending.
+    compressed_sub_ = nh_.subscribe(image_topic_ + "/compressed", 5,
+                                    &DepthInputs::OnCompressed, this);
+  } else {
+    std::string names;
+    for (const std::string& p : plugins) names += " " + p;
+    throw Error(Msg("image_transport = '", o.image_transport,
+                    "': no such image_transport plugin is installed "
+                    "(loadable:",
+                    names, ")"));
+  }
+}
+
+void DepthInputs::OnRaw(const sensor_msgs::ImageConstPtr& msg) {
+  DepthFrame f;
+  f.raw = msg;
+  f.stamp = msg->header.stamp;
+  f.frame_id = msg->header.frame_id;
+  on_frame_(std::move(f));
+}
+
+void DepthInputs::OnCompressed(
+    const sensor_msgs::CompressedImageConstPtr& msg) {
+  DepthFrame f;
+  f.compressed = msg;
+  f.stamp = msg->header.stamp;
+  f.frame_id = msg->header.frame_id;
+  on_frame_(std::move(f));
+}
+
+void DepthInputs::OnInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
+  infos_.Add(msg->header.stamp.toNSec(), msg);
+}
+
+void DepthInputs::OnPose(const geometry_msgs::PoseStampedConstPtr& msg) {
+  poses_.Add(msg->header.stamp.toNSec(), msg);
+}
+
+void DepthInputs::Stop() {
+  stopping_ = true;
+  infos_.Stop();
+  poses_.Stop();
+  image_sub_.shutdown();
+  compressed_sub_.shutdown();
+  points_sub_.shutdown();
+}
+
+std::string DepthInputs::Topic(const std::string& name) const {
+  return nh_.resolveName(name);
+}
+
+std::string DepthInputs::ImageTopic(const DepthFrame& f) const {
+  return image_topic_ + (f.raw ? "" : "/" + options_.image_transport);
+}
+
+std::string DepthInputs::NoSlash(const std::string& frame_id) {
+  const std::string stripped = StripLeadingSlash(frame_id);
+  if (stripped == frame_id) return frame_id;
+  bool first = false;
+  {
+    std::lock_guard<std::mutex> lock(slash_mutex_);
+    first = slash_warned_.insert(frame_id).second;
+  }
+  if (first)
+    ROS_WARN(
+        "%s: frame id '%s' starts with '/', which tf2 does not accept: "
+        "using '%s' (warned once per frame id)",
+        pnh_.getNamespace().c_str(), frame_id.c_str(), stripped.c_str());
+  return stripped;
+}
+
+void DepthInputs::OnSparsePoints(const wild_mvs::SparsePointsConstPtr& msg) {
+  if (NoSlash(msg->header.frame_id) != options_.world_frame) {
+    drop_(Topic("sparse_points"),
+          "frame_id '" + msg->header.frame_id + "' is not the world frame '" +
+              options_.world_frame + "'",
+          "");
+    return;
+  }
+  on_points_(StampedPointsFromMsg(*msg));
+}
+
+bool DepthInputs::PairCameraInfo(DepthFrame* f) {
+  // The camera's optical frame: ~camera_frame, else the image's.
+  f->frame_id = NoSlash(options_.camera_frame.empty() ? f->frame_id
+                                                      : options_.camera_frame);
+  // The camera_info with the frame's exact stamp (waiting up to tf_timeout
+  // of wall time for it), or with camera_info_latest the latest one.
+  if (options_.camera_info_latest) {
+    if (infos_.WaitLatest(options_.tf_timeout, &f->info)) return true;
+    drop_(info_topic_, "no camera_info received yet", "");
+    return false;
+  }
+  using Found = ExactStampBuffer<sensor_msgs::CameraInfoConstPtr>::Found;
+  const Found found =
+      infos_.WaitExact(f->stamp.toNSec(), options_.tf_timeout, &f->info);
+  if (found == Found::kYes) return true;
+  drop_(info_topic_,
+        found == Found::kOther
+            ? "no camera_info with the image's stamp (images and "
+              "camera_info are paired by exact stamp; set "
+              "camera_info_latest:=true for a driver that publishes it "
+              "once or at another rate)"
+            : "no camera_info received yet",
+        "");
+  return false;
+}
+
+bool DepthInputs::Convert(const DepthFrame& f, Camera* cam, cv::Mat* image) {
+  const std::string image_topic = ImageTopic(f);
+  Distortion dist;
+  try {
+    CameraFromCameraInfo(*f.info, cam, &dist, rectified_);
+  } catch (const Error& e) {
+    drop_(info_topic_, "invalid camera_info", e.what());
+    return false;
+  }
+  try {
+    *image = f.raw ? ImageToLinearRgb(*f.raw, options_.linearize)
+                   : CompressedToLinearRgb(*f.compressed, options_.linearize);
+  } catch (const Error& e) {
+    drop_(image_topic, "invalid image", e.what());
+    return false;
+  }
+  if (image->cols != cam->width || image->rows != cam->height) {
+    drop_(image_topic, "image size differs from camera_info",
+          Msg(image->cols, "x", image->rows, " vs ", cam->width, "x",
+              cam->height));
+    return false;
+  }
+  // Undistorted with maps built once per camera_info (a rectified
+  // input passes through: the camera is P's).
+  try {
+    *image = undistorter_->Apply(*f.info, *image, cam);
+  } catch (const Error& e) {
+    drop_(info_topic_, "invalid camera_info", e.what());
+    return false;
+  }
+  return LookupPose(f, cam);
+}
+
+// Pose of the frame from tf or the pose topic; false (and counted) when
+// there is none within the timeout.
+bool DepthInputs::LookupPose(const DepthFrame& f, Camera* cam) {
+  const DepthNodeOptions& o = options_;
+  if (o.pose_source == "tf") {
+    if (f.frame_id.empty()) {
+      drop_(Topic("image"), "image has an empty frame_id (needed for tf)", "");
+      return false;
+    }
+    geometry_msgs::TransformStamped T;
+    try {
+      // Wait in wall time (tf2's own timeout runs on ROS time, which
+      // stands still when /clock pauses), polling the buffer.
+      const auto deadline = std::chrono::steady_clock::now() +
+                            std::chrono::duration<double>(o.tf_timeout);
+      while (!tf_buffer_->canTransform(o.world_frame, f.frame_id, f.stamp) &&
+             std::chrono::steady_clock::now() < deadline) {
+        if (stopping_) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+      T = tf_buffer_->lookupTransform(o.world_frame, f.frame_id, f.stamp);
+    } catch (const tf2::TransformException& e) {
+      drop_("tf",
+            "no transform " + o.world_frame + " <- " + f.frame_id +
+                " at the image stamp within tf_timeout",
+            e.what());
+      return false;
+    }
+    try {
+      SetCameraPose(T.transform, cam);
+    } catch (const Error& e) {
+      drop_("tf", "invalid pose", e.what());
+      return false;
+    }
+    return true;
+  }
+  // Pose topic: the pose whose stamp is closest, within the tolerance.
+  geometry_msgs::PoseStampedConstPtr best;
+  if (!poses_.WaitNearest(f.stamp.toNSec(), o.pose_sync_tolerance, o.tf_timeout,
+                          &best)) {
+    drop_(Topic("pose"),
+          "no pose within pose_sync_tolerance of the image "
+          "stamp within tf_timeout",
+          "");
+    return false;
+  }
+  if (NoSlash(best->header.frame_id) != o.world_frame) {
+    drop_(Topic("pose"),
+          "pose frame_id '" + best->header.frame_id +
+              "' is not the world frame '" + o.world_frame + "'",
+          "");
+    return false;
+  }
+  try {
+    SetCameraPose(best->pose, cam);
+  } catch (const Error& e) {
+    drop_(Topic("pose"), "invalid pose", e.what());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace ros1
+}  // namespace wild_mvs

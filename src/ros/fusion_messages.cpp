@@ -1,0 +1,68 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/ros/fusion_messages.h"
+
+#include <chrono>
+
+#include "wild_mvs/ros/conversions.h"
+
+namespace wild_mvs {
+namespace ros1 {
+
+FusionView FusionViewFromMsg(const wild_mvs::DepthView& msg) {
+  FusionView view;
+  view.map = DepthMapFromDepthView(msg);
+  if (!msg.image.data.empty()) {
+    view.image = ImageToLinearRgb(msg.image, true);
+    if (view.image.size() != view.map.depth.size()) view.image.release();
+  }
+  view.keyframe_id = msg.keyframe_id;
+  view.session_ns = msg.session.toNSec();
+  for (const ros::Time& s : msg.neighbor_stamps)
+    view.neighbor_stamps_ns.push_back(s.toNSec());
+  view.stamp_ns = msg.header.stamp.toNSec();
+  view.arrived = std::chrono::steady_clock::now();
+  return view;
+}
+
+FusionSessionOptions SessionOptions(const FusionNodeOptions& o) {
+  FusionSessionOptions so;
+  so.reorder_timeout = o.reorder_timeout;
+  so.on_new_session = o.on_new_session;
+  so.output_path = o.output_path;
+  so.map_store_mb = o.map_store_mb;
+  so.spill_dir = o.spill_dir;
+  so.fusion = o.fusion;
+  return so;
+}
+
+void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
+                           size_t queued, const DropCounter& drops,
+                           diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const uint64_t dropped = drops.Total();
+  if (dropped > 0)
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                  "%lu depth views dropped",
+                  static_cast<unsigned long>(dropped));
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
+  stat.add("views received", received);
+  stat.add("input queue length", queued);
+  stat.add("views waiting for order", s.waiting);
+  stat.add("views fused", s.fused);
+  stat.add("revisions ignored", s.revisions_ignored);
+  stat.add("points", s.fusion.points);
+  stat.add("pending samples", s.fusion.pending);
+  stat.add("fusion bytes", s.fusion_bytes);
+  stat.add("held depth map MB", s.held_mb);
+  stat.add("depth maps spilled", s.spilled);
+  stat.add("last seconds per view", s.last_fuse_seconds);
+  stat.add("resets", s.resets);
+  stat.add("depth sessions", s.sessions);
+  stat.add("session clouds saved", s.session_saves);
+  stat.add("views dropped", dropped);
+  for (const auto& [reason, n] : drops.Counts())
+    stat.add("dropped: " + reason, n);
+}
+
+}  // namespace ros1
+}  // namespace wild_mvs
