@@ -123,4 +123,30 @@ void KeyframeStore::Clear() {
   bytes_ = 0;
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeSelectionOptions* o) {
+  registry
+      ->Add(OptionRegistry::Join(prefix, "keyframe_min_baseline"),
+            &o->min_baseline, "m from the last keyframe that make a keyframe")
+      .Min(0);
+  registry
+      ->Add(OptionRegistry::Join(prefix, "keyframe_min_angle_deg"),
+            &o->min_angle_deg,
+            "... or this viewing-angle change (degrees) makes a keyframe")
+      .Min(0)
+      .Max(180);
+}
+
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeStoreOptions* o) {
+  registry
+      ->Add(OptionRegistry::Join(prefix, "max_keyframes"), &o->max_keyframes,
+            "keyframe store bound: count (least useful evicted)")
+      .Min(2);
+  registry
+      ->Add(OptionRegistry::Join(prefix, "max_keyframe_mb"), &o->max_mb,
+            "keyframe store bound: image megabytes")
+      .Above(0);
+}
+
 }  // namespace wild_mvs

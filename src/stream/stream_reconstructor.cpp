@@ -447,4 +447,70 @@ int StreamReconstructor::GoodNeighbors(uint32_t id) const {
   return 0;
 }
 
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     StreamOptions* o) {
+  auto key = [&prefix](const char* name) {
+    return OptionRegistry::Join(prefix, name);
+  };
+  registry
+      ->Add(key("stamp_reset_threshold"), &o->stamp_reset_threshold,
+            "s: a stamp this far back resets the stream (bag loop); smaller "
+            "steps back are dropped")
+      .Above(0);
+  registry
+      ->Add(key("max_pose_jump"), &o->max_pose_jump,
+            "m between frames < 1 s apart that count as a pose reset, 0 = off")
+      .Min(0);
+  RegisterOptions(registry, prefix, &o->keyframes);
+  RegisterOptions(registry, prefix, &o->store);
+  registry
+      ->Add(key("max_image_size"), &o->max_image_size,
+            "longest image side kept, 0 = as received")
+      .Min(16)
+      .OrZero();
+  registry
+      ->Add(key("num_threads"), &o->num_threads,
+            "threads inside one reconstruction")
+      .Min(1);
+  registry
+      ->Add(key("max_pending"), &o->max_pending,
+            "reconstructions queued or running")
+      .Min(1);
+  registry
+      ->Add(key("min_neighbors"), &o->min_neighbors,
+            "good neighbours (global view selection) before reconstructing")
+      .Min(1);
+  registry
+      ->Add(key("lookahead"), &o->lookahead,
+            "... and this many later keyframes (or idle_flush s without one)")
+      .Min(0);
+  registry
+      ->Add(key("idle_flush"), &o->idle_flush,
+            "s without a new keyframe after which ready keyframes are "
+            "reconstructed")
+      .Min(0);
+  registry
+      ->Add(key("redo_min_gain"), &o->redo_min_gain,
+            "redo a keyframe when its neighbour score grew by this factor, "
+            "0 = never")
+      .Above(1)
+      .OrZero();
+  registry
+      ->Add(key("max_redo"), &o->max_redo,
+            "at most this many redos per keyframe")
+      .Min(0);
+  registry
+      ->Add(key("worker_index"), &o->worker_index,
+            "several workers: this one reconstructs keyframes with index % "
+            "worker_count == worker_index")
+      .Min(0)
+      .Note("< worker_count");
+  registry
+      ->Add(key("worker_count"), &o->worker_count, "number of depth workers")
+      .Min(1);
+  // use_tracker follows the node's sparse_source.
+  RegisterOptions(registry, key("mvs"), &o->mvs);
+  RegisterOptions(registry, key("tracker"), &o->tracker);
+}
+
 }  // namespace wild_mvs

@@ -166,15 +166,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      DepthNodeOptions* options);
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      FusionNodeOptions* options);
-// StreamOptions and the keyframe options are registered in params.cpp, not
-// beside their structs, while the stream code moves out of src/ros; they
-// belong beside the structs afterwards.
-void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
-                     StreamOptions* options);
-void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
-                     KeyframeSelectionOptions* options);
-void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
-                     KeyframeStoreOptions* options);
+// (StreamOptions and the keyframe options register beside their structs in
+// src/stream.)
 
 // Reads the options (defaults for unset parameters), checks them, and throws
 // Error naming "<where>/<param>" or the option on a bad value.

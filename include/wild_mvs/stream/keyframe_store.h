@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "wild_mvs/core/camera.h"
+#include "wild_mvs/core/option_registry.h"
 
 namespace wild_mvs {
 
@@ -59,6 +60,12 @@ struct KeyframeStoreOptions {
   double max_mb = 512;     // image bytes bound, megabytes
   void Check() const;
 };
+// Register the fields under `prefix` (option_registry.h); the depth node
+// uses prefix "" (keyframe_min_baseline, max_keyframes, ...).
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeSelectionOptions* options);
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     KeyframeStoreOptions* options);
 
 class KeyframeStore {
  public:

@@ -28,6 +28,7 @@
 #include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/core/sparse_tracker.h"
@@ -72,6 +73,10 @@ struct StreamOptions {
   TrackerOptions tracker;   // the incremental tracker (use_tracker)
   void Check() const;
 };
+// Registers the fields under `prefix` (option_registry.h); the depth node
+// uses prefix "" (num_threads, ..., mvs/..., tracker/...).
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     StreamOptions* options);
 
 // One reconstructed keyframe.
 struct StreamResult {
