@@ -15,6 +15,8 @@ void DepthSweepOptions::Check() const {
           "]");
   Require(min_score >= -1 && min_score <= 1, "sweep.min_score = ", min_score,
           " must be in [-1, 1]");
+  Require(below_seeds >= 0, "sweep.below_seeds = ", below_seeds,
+          " must be >= 0");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -40,6 +42,11 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "fallback depth sweep: seed only above this mean NCC")
       .Min(-1)
       .Max(1);
+  registry
+      ->Add(key("below_seeds"), &o->below_seeds,
+            "also sweep (the pixels still empty) when fewer sparse features "
+            "than this matched; 0 = only when none did")
+      .Min(0);
 }
 
 std::vector<Seed> SweepSeeds(const PatchContext& context,

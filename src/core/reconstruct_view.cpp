@@ -36,6 +36,7 @@ MvsOptions PaperMvsOptions() {
   o.mpgc.normal_step_halvings = 0;
   o.growing.revisit_margin = 0;
   o.growing.hypotheses = 0;
+  o.sweep.below_seeds = 0;
   o.consistency.enabled = false;
   return o;
 }
@@ -248,8 +249,10 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
     if (!seeds.empty())
       GrowRegions(ctx, options.mpgc, options.local, options.growing, seeds,
                   wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats);
-    if (stats.seeds_accepted == 0) {
-      // No sparse feature produced a match: seed from a plane sweep.
+    if (stats.seeds_accepted == 0 ||
+        stats.seeds_accepted < options.sweep.below_seeds) {
+      // No (or too few) sparse features produced a match: seed the pixels
+      // still empty from a plane sweep.
       double lo = dmin, hi = dmax;
       if (!(lo > 0) || !(hi > lo)) {
         lo = scene_depth * 0.5;
@@ -258,13 +261,19 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
       lo *= 0.8;
       hi *= 1.25;
       std::vector<Seed> swept;
+      cv::Mat empty = dm.depth <= 0;  // CV_8U, 255 where nothing grew
+      if (!wmask.empty()) empty &= wmask;
       if (scene_depth > 0)
         swept = SweepSeeds(ctx, options.mpgc, options.local, options.sweep, lo,
-                           hi, wmask, pool, &body_cpu);
+                           hi, empty, pool, &body_cpu);
+      const std::string why =
+          seeds.empty()               ? "no sparse feature projects into it"
+          : stats.seeds_accepted == 0 ? "no sparse feature could be matched"
+                                      : Msg("only ", stats.seeds_accepted,
+                                            " sparse features matched (< "
+                                            "sweep.below_seeds)");
       rep.fallbacks.push_back(
-          Msg("fallback: view '", scene.views[ref].name, "': ",
-              seeds.empty() ? "no sparse feature projects into it"
-                            : "no sparse feature could be matched",
+          Msg("fallback: view '", scene.views[ref].name, "': ", why,
               "; seeded from a fronto-parallel depth sweep over [", lo, ", ",
               hi, "]: ", swept.size(), " seeds"));
       if (!swept.empty())

@@ -193,6 +193,31 @@ TEST_F(MvsEndToEnd, NoSparsePointsFallsBack) {
   EXPECT_GT(r.inlier_ratio, 0.93);
 }
 
+// With only a handful of sparse points (fewer than sweep.below_seeds match)
+// the depth sweep also seeds the pixels still empty, and the driver says
+// so; the sweep's seeds must not cost completeness or accuracy (on this
+// connected scene growth from 3 seeds already reaches most of it).
+TEST_F(MvsEndToEnd, FewSparsePointsAddSweepSeeds) {
+  SyntheticScene s = *lit_;
+  s.scene.points.resize(4);
+  ViewReport rep;
+  MvsOptions few;
+  few.sweep.below_seeds = 0;
+  const DepthScore r0 = Score(s, Run(s, 3, few, 2, &rep), 0.01);
+  Print("view 3, 4 sparse points, no sweep", r0);
+  const DepthScore r1 = Score(s, Run(s, 3, MvsOptions(), 2, &rep), 0.01);
+  Print("view 3, 4 sparse points, sweep", r1);
+  bool said = false;
+  for (const auto& f : rep.fallbacks) {
+    std::printf("%s\n", f.c_str());
+    said = said || f.find("sweep.below_seeds") != std::string::npos;
+  }
+  EXPECT_TRUE(said);
+  EXPECT_GE(r1.completeness, r0.completeness);
+  EXPECT_GT(r1.completeness, 0.75);
+  EXPECT_GT(r1.inlier_ratio, 0.93);
+}
+
 // The paper's ablations, on the paper's pipeline (--preset paper): each
 // switch costs what the paper says it should under the strong lighting
 // changes of this scene. Fixed colour scales lose nearly everything here;
