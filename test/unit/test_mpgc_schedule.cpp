@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "patch_context_util.h"
 #include "synthetic_scene.h"
 #include "wild_mvs/core/mpgc.h"
 #include "wild_mvs/core/patch.h"
@@ -21,26 +22,8 @@ using Kind = MatchTrace::Kind;
 using testing::Render;
 using testing::SyntheticScene;
 
-MatchImage AsMatch(const cv::Mat& m) {
-  MatchImage im;
-  im.data = m.ptr<float>();
-  im.width = m.cols;
-  im.height = m.rows;
-  im.channels = m.channels();
-  return im;
-}
-
-PatchContext MakeContext(const SyntheticScene& s, int ref) {
-  PatchContext ctx;
-  ctx.ref_camera = s.scene.views[ref].camera;
-  ctx.ref_image = AsMatch(s.images[ref]);
-  for (size_t v = 0; v < s.scene.views.size(); ++v) {
-    if (static_cast<int>(v) == ref) continue;
-    ctx.AddView(static_cast<int>(v), s.scene.views[v].camera,
-                AsMatch(s.images[v]), 1.0);
-  }
-  return ctx;
-}
+using testing::AsMatch;
+using testing::MakeContext;
 
 // A textured plane 20 degrees off fronto-parallel seen by 5 cameras on a
 // short arc, constant light, no noise.

@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "patch_context_util.h"
 #include "synthetic_scene.h"
 #include "wild_mvs/core/global_view_selection.h"
 #include "wild_mvs/core/local_view_selection.h"
@@ -74,28 +75,8 @@ TEST(MvsNcc, InvariantToGainAndOffsetDropsForUnrelated) {
 
 // ------------------------------------------------------------------ MPGC
 
-MatchImage AsMatch(const cv::Mat& m) {
-  MatchImage im;
-  im.data = m.ptr<float>();
-  im.width = m.cols;
-  im.height = m.rows;
-  im.channels = m.channels();
-  return im;
-}
-
-// A PatchContext for view `ref` of a rendered scene with all other views as
-// neighbours (global score 1).
-PatchContext MakeContext(const SyntheticScene& s, int ref) {
-  PatchContext ctx;
-  ctx.ref_camera = s.scene.views[ref].camera;
-  ctx.ref_image = AsMatch(s.images[ref]);
-  for (size_t v = 0; v < s.scene.views.size(); ++v) {
-    if (static_cast<int>(v) == ref) continue;
-    ctx.AddView(static_cast<int>(v), s.scene.views[v].camera,
-                AsMatch(s.images[v]), 1.0);
-  }
-  return ctx;
-}
+using testing::AsMatch;
+using testing::MakeContext;
 
 // Slanted plane seen by 5 cameras with different exposure and white balance
 // (linear: gamma 1), so the colour scale of view V w.r.t. R is exactly
