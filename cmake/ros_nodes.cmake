@@ -90,9 +90,10 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
     target_compile_definitions(${name} PRIVATE
       WILD_MVS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
     target_compile_options(${name} PRIVATE ${WILD_MVS_WARNINGS})
-    add_test(NAME ${name} COMMAND ${name})
-    set_tests_properties(${name} PROPERTIES TIMEOUT 300
-      SKIP_REGULAR_EXPRESSION "\\[  SKIPPED \\]")
+    # One ctest test per gtest case, ros_<executable>.<Suite>.<Case>
+    # (skips show as skipped; see the unit tests in CMakeLists.txt).
+    gtest_discover_tests(${name} TEST_PREFIX "${name}." DISCOVERY_MODE PRE_TEST
+      DISCOVERY_TIMEOUT 120 PROPERTIES TIMEOUT 300)
   endforeach()
 
   # rostests: each test/ros/*.test launches the nodes and a checker node
