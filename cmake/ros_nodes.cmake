@@ -151,6 +151,14 @@ if(WILD_MVS_BUILD_TESTS AND CATKIN_ENABLE_TESTING)
             ${CATKIN_DEVEL_PREFIX} ${CMAKE_CURRENT_SOURCE_DIR})
   set_tests_properties(ros_own_bag PROPERTIES TIMEOUT 600)
 
+  # `wild_mvs to-bag` writes a rendered dataset as a bag; the bag is read
+  # back (rosbag info, python3-rosbag) and compared with the dataset.
+  add_test(NAME ros_to_bag
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_to_bag.sh
+            $<TARGET_FILE:wild_mvs> $<TARGET_FILE:make_scene>
+            ${CATKIN_DEVEL_PREFIX})
+  set_tests_properties(ros_to_bag PROPERTIES TIMEOUT 300)
+
   file(GLOB WILD_MVS_ROSTESTS CONFIGURE_DEPENDS test/ros/*.test)
   foreach(file ${WILD_MVS_ROSTESTS})
     add_rostest(${file} DEPENDENCIES ${WILD_MVS_ROSTEST_TARGETS}
