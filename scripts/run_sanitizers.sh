@@ -15,14 +15,16 @@
 #  2. ThreadSanitizer (opt-in, --tsan or --tsan-only; WILD_MVS_TSAN=1 for
 #     scripts/run_tests.sh): build-tsan/, the parallel code: the fusion
 #     tests and the MVS end-to-end test that runs ReconstructView with 2
-#     threads (TSAN_TESTS, TSAN_GTEST_FILTER). Runs under `setarch -R` when
+#     threads (TSAN_TESTS, TSAN_EXCLUDE). Runs under `setarch -R` when
 #     available (TSan fails on some kernels with "unexpected memory mapping"
 #     when ASLR is on).
 # Usage: scripts/run_sanitizers.sh [--tsan|--tsan-only]
 # Environment: JOBS (default: cores), FUZZ_BUILD_DIR (the ASan build,
 #   default build-fuzz), TSAN_BUILD_DIR, ASAN_TESTS (ctest -R regex, default
 #   all), ASAN_EXCLUDE (ctest -E regex, default the ROS tests), TSAN_TESTS
-#   (ctest -R regex), TSAN_GTEST_FILTER.
+#   (ctest -R regex), TSAN_EXCLUDE (ctest -E regex). A gtest case is the
+#   ctest test <executable>.<Suite>.<Case> (<executable>_NOT_BUILT before
+#   the build; gtest_discover_tests).
 set -eo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 source "$ROOT/scripts/common.sh"
@@ -30,8 +32,8 @@ ASAN_BUILD_DIR="${FUZZ_BUILD_DIR:-$ROOT/build-fuzz}"
 TSAN_BUILD_DIR="${TSAN_BUILD_DIR:-$ROOT/build-tsan}"
 ASAN_TESTS="${ASAN_TESTS:-.}"
 ASAN_EXCLUDE="${ASAN_EXCLUDE:-^(_ctest_|ros_)}"
-TSAN_TESTS="${TSAN_TESTS:-^test_(fusion|fusion_synthetic|mvs_end_to_end)$}"
-TSAN_GTEST_FILTER="${TSAN_GTEST_FILTER:-*:-MvsEndToEnd.Ablations:MvsEndToEnd.VaryingLightingAndOccluder}"
+TSAN_TESTS="${TSAN_TESTS:-^test_(fusion|fusion_synthetic|mvs_end_to_end)(\.|_NOT_BUILT$)}"
+TSAN_EXCLUDE="${TSAN_EXCLUDE:-\.MvsEndToEnd\.(Ablations|VaryingLightingAndOccluder)$}"
 do_asan=1 do_tsan=0
 case "${1:-}" in
   --tsan) do_tsan=1 ;;
@@ -49,12 +51,13 @@ configure() {  # build-dir cmake-args...
     "${CCACHE_ARGS[@]}" "$@" >"$dir/cmake.log" 2>&1 || { cat "$dir/cmake.log"; return 1; }
 }
 # The build targets of the tests selected by ctest arguments (cli_* tests
-# run the tool).
+# run the tool; a gtest case <executable>.<Suite>.<Case>, or the placeholder
+# <executable>_NOT_BUILT of a test binary not built yet, names its binary).
 test_targets() {  # build-dir ctest-args...
   local dir="$1"
   shift
   ctest --test-dir "$dir" -N "$@" | sed -n 's/^ *Test *#[0-9]*: *//p' |
-    sed 's/^cli_.*/wild_mvs/' | sort -u | tr '\n' ' '
+    sed 's/^cli_.*/wild_mvs/; s/_NOT_BUILT$//; s/\..*$//' | sort -u | tr '\n' ' '
 }
 build() {  # build-dir targets...
   local dir="$1"
@@ -105,7 +108,9 @@ if [ "$do_tsan" = 1 ]; then
     -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=thread"
-  targets="$(test_targets "$TSAN_BUILD_DIR" -R "$TSAN_TESTS")"
+  tsel=(-R "$TSAN_TESTS")
+  [ -n "$TSAN_EXCLUDE" ] && tsel+=(-E "$TSAN_EXCLUDE")
+  targets="$(test_targets "$TSAN_BUILD_DIR" "${tsel[@]}")"
   if [ -z "$targets" ]; then
     echo "run_sanitizers.sh: no tests match $TSAN_TESTS"
     status=1
@@ -113,12 +118,11 @@ if [ "$do_tsan" = 1 ]; then
     build "$TSAN_BUILD_DIR" "$targets"
     built=$(date +%s)
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$SUPP/tsan.supp"
-    export GTEST_FILTER="$TSAN_GTEST_FILTER"
     norandom=()
     setarch -R true 2>/dev/null && norandom=(setarch -R)
     # ctest -j1: the parallel tests use every core themselves.
     if "${norandom[@]}" ctest --test-dir "$TSAN_BUILD_DIR" --output-on-failure \
-      -R "$TSAN_TESTS" 2>&1 | tee "$TSAN_BUILD_DIR/ctest.log"; then
+      "${tsel[@]}" 2>&1 | tee "$TSAN_BUILD_DIR/ctest.log"; then
       :
     else
       status=1
@@ -127,7 +131,7 @@ if [ "$do_tsan" = 1 ]; then
       echo "run_sanitizers.sh: ThreadSanitizer findings or failure (see $TSAN_BUILD_DIR/ctest.log)"
       status=1
     fi
-    unset TSAN_OPTIONS GTEST_FILTER
+    unset TSAN_OPTIONS
     echo "run_sanitizers.sh: TSan build $((built - start)) s, tests $(($(date +%s) - built)) s"
   fi
 fi

@@ -204,8 +204,11 @@ TEST_F(BadInput, NodesSurviveAndCountEveryProblem) {
       "[bad_input] peak RSS depth_node %.0f MB, fusion_node %.0f MB; "
       "depth_node diagnostics:\n%s",
       depth_rss, fusion_rss, diag_->Dump("depth_node").c_str());
-  EXPECT_LT(depth_rss, 600.0);
-  EXPECT_LT(fusion_rss, 400.0);
+  // RSS ceilings about 2x the measured peaks (103-107 / 81-82 MB; docs/ROS.md).
+  EXPECT_GT(depth_rss, 0);
+  EXPECT_GT(fusion_rss, 0);
+  EXPECT_LT(depth_rss, 210.0);
+  EXPECT_LT(fusion_rss, 170.0);
 }
 
 }  // namespace

@@ -306,7 +306,8 @@ TEST_F(Faults, RestartPoseJumpLoadAndSigtermSave) {
   EXPECT_LE(max_pending, 2);  // max_pending
   EXPECT_LE(max_fusion_queue, 10);
   EXPECT_GT(depth_rss, 0);
-  EXPECT_LT(depth_rss, 400.0);  // RSS ceiling (measured ~100-150 MB)
+  // RSS ceiling about 2x the measured peak (94-95 MB; docs/ROS.md).
+  EXPECT_LT(depth_rss, 200.0);
   // The nodes are still up and the cloud is still right.
   EXPECT_EQ(NodePid("/depth_node"), depth_pid);
   WaitFor(
@@ -349,6 +350,9 @@ TEST_F(Faults, RestartPoseJumpLoadAndSigtermSave) {
       "[faults] SIGTERM: fusion node saved %ld points (diagnostics: "
       "%ld); peak RSS fusion_node %.0f MB\n",
       vertices, points, fusion_rss);
+  // RSS ceiling about 2x the measured peak (91-101 MB; docs/ROS.md).
+  EXPECT_GT(fusion_rss, 0);
+  EXPECT_LT(fusion_rss, 200.0);
   fs::remove_all(fs::path(out).parent_path());
   // The second fusion node too (it saves on exit), then clean up.
   const int reset_pid = NodePid("/fusion_reset");

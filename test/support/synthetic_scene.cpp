@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
+#include "synthetic_lens.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/thread_pool.h"
 #include "wild_mvs/io/atomic_file.h"
@@ -298,6 +299,26 @@ Eigen::Vector3d RayDir(const Camera& cam, double u, double v) {
          Eigen::Vector3d((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0);
 }
 
+// The undistorted (pinhole) pixel whose distortion by `d` is pixel px of
+// the distorted image (fixed-point iteration on normalised coordinates).
+Eigen::Vector2d UndistortedPixel(const Camera& cam, const Distortion& d,
+                                 double u, double v) {
+  const double xd = (u - cam.cx) / cam.fx, yd = (v - cam.cy) / cam.fy;
+  double x = xd, y = yd;
+  for (int it = 0; it < 50; ++it) {
+    const double r2 = x * x + y * y;
+    const double radial = 1 + d.k1 * r2 + d.k2 * r2 * r2 + d.k3 * r2 * r2 * r2;
+    const double dx = 2 * d.p1 * x * y + d.p2 * (r2 + 2 * x * x);
+    const double dy = d.p1 * (r2 + 2 * y * y) + 2 * d.p2 * x * y;
+    const double nx = (xd - dx) / radial, ny = (yd - dy) / radial;
+    const double change = std::abs(nx - x) + std::abs(ny - y);
+    x = nx;
+    y = ny;
+    if (change < 1e-14) break;
+  }
+  return {cam.fx * x + cam.cx, cam.fy * y + cam.cy};
+}
+
 Camera LookAtCamera(const Eigen::Vector3d& center,
                     const Eigen::Vector3d& target, int width, int height,
                     double focal) {
@@ -368,9 +389,16 @@ void ExtendBounds(const SyntheticObject& o, Eigen::Vector3d* lo,
 // ------------------------------------------------------------------ render
 
 SyntheticScene Render(const SyntheticSpec& spec) {
+  return Render(spec, SyntheticLens());
+}
+
+SyntheticScene Render(const SyntheticSpec& spec, const SyntheticLens& lens) {
   Require(spec.width > 0 && spec.height > 0, "synthetic spec: image size ",
           spec.width, "x", spec.height, " must be positive");
   Require(spec.focal > 0, "synthetic spec: focal = ", spec.focal,
+          " must be > 0");
+  Require(lens.focal_y_ratio > 0,
+          "synthetic spec: focal_y_ratio = ", lens.focal_y_ratio,
           " must be > 0");
   Require(spec.supersample >= 1,
           "synthetic spec: supersample = ", spec.supersample, " must be >= 1");
@@ -405,6 +433,10 @@ SyntheticScene Render(const SyntheticSpec& spec) {
     v.name = name;
     v.camera = LookAtCamera(spec.camera_centers[i], spec.look_at, W, H,
                             spec.focals.empty() ? spec.focal : spec.focals[i]);
+    v.camera.fy = lens.focal_y_ratio * v.camera.fx;
+    v.camera.cx += lens.principal_offset.x();
+    v.camera.cy += lens.principal_offset.y();
+    v.distortion = lens.distortion;
     out.scene.views.push_back(v);
   }
   out.images.resize(n);
@@ -421,6 +453,7 @@ SyntheticScene Render(const SyntheticSpec& spec) {
     cv::Mat img(H, W, CV_32FC3), dep(H, W, CV_32F), nor(H, W, CV_32FC3),
         ids(H, W, CV_32S);
     const double inv_gamma = 1.0 / light.gamma;
+    const bool distorted = !lens.distortion.IsNone();
     const Eigen::Vector3d sun = light.sun.squaredNorm() > 0
                                     ? Eigen::Vector3d(light.sun.normalized())
                                     : Eigen::Vector3d::Zero();
@@ -451,7 +484,9 @@ SyntheticScene Render(const SyntheticSpec& spec) {
         for (int sy = 0; sy < ss; ++sy) {
           for (int sx = 0; sx < ss; ++sx) {
             const double u = c + (sx + 0.5) / ss, v = r + (sy + 0.5) / ss;
-            const Eigen::Vector3d d = RayDir(cam, u, v);
+            Eigen::Vector2d p(u, v);
+            if (distorted) p = UndistortedPixel(cam, lens.distortion, u, v);
+            const Eigen::Vector3d d = RayDir(cam, p.x(), p.y());
             const Hit s = Cast(objs, i, C, d);
             Eigen::Vector3d Ls;
             if (s.object < 0) {
