@@ -321,7 +321,18 @@ TEST_F(Faults, RestartPoseJumpLoadAndSigtermSave) {
   // --- 4. SIGTERM: the fusion node saves to ~output_path atomically ------
   std::string out;
   ASSERT_TRUE(ros::param::get("/fusion_node/output_path", out));
-  const long points = diag.Get("fusion_node: ", "points");
+  // The fusion node may still be fusing the last depth maps: read its point
+  // count once it has stopped changing (two diagnostics reports apart).
+  long points = diag.Get("fusion_node: ", "points");
+  WaitFor(
+      [&] {
+        ros::WallDuration(2.5).sleep();
+        const long now = diag.Get("fusion_node: ", "points");
+        const bool stable = now == points;
+        points = now;
+        return stable;
+      },
+      60);
   fs::create_directories(fs::path(out).parent_path());
   {
     std::ofstream old(out);
