@@ -4,44 +4,13 @@
 #include <cmath>
 
 #include "sparse_tracker_impl.h"
+#include "wild_mvs/core/stats.h"
 #include "wild_mvs/core/triangulation.h"
+#include "wild_mvs/core/view_geometry.h"
 
 namespace wild_mvs {
 
 using sparse_internal::kDeg;
-
-namespace {
-
-// Fraction of sample points of cam's frustum (image grid x depths) that
-// project into other's image in front of it.
-double Overlap(const Camera& cam, const Camera& other,
-               const std::vector<double>& depths) {
-  constexpr int kGx = 8, kGy = 6;
-  int in = 0, total = 0;
-  for (double d : depths) {
-    for (int gy = 0; gy < kGy; ++gy) {
-      for (int gx = 0; gx < kGx; ++gx) {
-        const Eigen::Vector2d px((gx + 0.5) * cam.width / kGx,
-                                 (gy + 0.5) * cam.height / kGy);
-        Eigen::Vector2d q;
-        ++total;
-        if (other.Project(cam.Backproject(px, d), &q) && other.InImage(q)) {
-          ++in;
-        }
-      }
-    }
-  }
-  return total ? static_cast<double>(in) / total : 0.0;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
-}
-
-}  // namespace
 
 // Typical depth of the scene seen by `cam` (0 = unknown).
 double SparseTracker::Impl::EstimateDepth(const Camera& cam) const {
@@ -56,17 +25,13 @@ double SparseTracker::Impl::EstimateDepth(const Camera& cam) const {
   if (depths.size() >= 20) return Median(depths);
   // Convergence of the optical axes.
   depths.clear();
-  const Eigen::Vector3d c0 = cam.Center(), d0 = cam.ViewDirection();
+  const double min_sin2 = std::pow(std::sin(1.0 * kDeg), 2);  // ~parallel
   for (const ViewData& v : views) {
     if (v.removed) continue;
-    const Eigen::Vector3d c1 = v.camera.Center(), d1 = v.camera.ViewDirection();
-    const double b = d0.dot(d1);
-    const double den = 1 - b * b;
-    if (den < std::pow(std::sin(1.0 * kDeg), 2)) continue;  // ~parallel
-    const Eigen::Vector3d w = c0 - c1;
-    const double s = (b * d1.dot(w) - d0.dot(w)) / den;
-    const double t = (d1.dot(w) - b * d0.dot(w)) / den;
-    if (s > 0 && t > 0) depths.push_back(s);
+    double s;
+    if (AxesClosestApproachDepth(cam, v.camera, min_sin2, &s)) {
+      depths.push_back(s);
+    }
   }
   return depths.empty() ? 0 : Median(depths);
 }
@@ -88,9 +53,9 @@ std::vector<int> SparseTracker::Impl::SelectNeighbors(const Camera& cam) const {
     double score = 0;
     if (depth > 0) {
       const double overlap =
-          Overlap(cam, v.camera,
-                  {0.5 * depth, std::sqrt(0.5) * depth, depth,
-                   std::sqrt(2.0) * depth, 2 * depth});
+          FrustumGridOverlap(cam, v.camera,
+                             {0.5 * depth, std::sqrt(0.5) * depth, depth,
+                              std::sqrt(2.0) * depth, 2 * depth});
       if (overlap < opt.min_overlap) continue;
       const Eigen::Vector3d X = cam.Backproject(
           Eigen::Vector2d(0.5 * cam.width, 0.5 * cam.height), depth);
@@ -105,7 +70,7 @@ std::vector<int> SparseTracker::Impl::SelectNeighbors(const Camera& cam) const {
       const double far = b / std::tan(std::max(min_angle, 0.5 * kDeg));
       std::vector<double> depths;
       for (double d = b; d <= far * 1.0001; d *= 2) depths.push_back(d);
-      score = Overlap(cam, v.camera, depths);
+      score = FrustumGridOverlap(cam, v.camera, depths);
       if (score < opt.min_overlap) continue;
     }
     scored.emplace_back(-score, static_cast<int>(s));
