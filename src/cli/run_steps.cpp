@@ -18,6 +18,7 @@
 #include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/depth_map_io.h"
+#include "wild_mvs/io/report_json.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -199,7 +200,8 @@ DepthStageResult RunDepthStage(const Scene& scene,
         names.push_back(scene.views[n].name);
       }
     }
-    WriteViewOutputs(scene, view, raw, map, names, report.ToJson(scene), "");
+    WriteViewOutputs(scene, view, raw, map, names,
+                     ViewReportJson(report, scene), "");
     const int valid = map.CountValid();
     if (filter) {
       to_filter.push_back(v);
