@@ -7,8 +7,7 @@
 //   retriangulation.cpp    Impl::Rebuild
 //   track_compaction.cpp   Impl::Compact
 //   sparse_tracker.cpp     options and the public SparseTracker driver
-#ifndef WILD_MVS_CORE_SPARSE_TRACKER_IMPL_H_
-#define WILD_MVS_CORE_SPARSE_TRACKER_IMPL_H_
+#pragma once
 
 #include <cmath>
 #include <map>
@@ -110,5 +109,3 @@ struct SparseTracker::Impl {
 };
 
 }  // namespace wild_mvs
-
-#endif  // WILD_MVS_CORE_SPARSE_TRACKER_IMPL_H_

@@ -1,7 +1,6 @@
 // Copyright wild_mvs authors. Small statistics and process measurements
 // shared by the core, the command-line tool and the benchmarks.
-#ifndef WILD_MVS_CORE_STATS_H_
-#define WILD_MVS_CORE_STATS_H_
+#pragma once
 
 #include <algorithm>
 #include <vector>
@@ -26,5 +25,3 @@ double CpuSeconds();
 double PeakRssMb();
 
 }  // namespace wild_mvs
-
-#endif  // WILD_MVS_CORE_STATS_H_

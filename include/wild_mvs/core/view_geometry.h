@@ -1,8 +1,7 @@
 // Copyright wild_mvs authors. Geometry of view pairs shared by the pair
 // selection of the sparse tracker and by global view selection: how much of
 // one camera's frustum another sees, and where two optical axes meet.
-#ifndef WILD_MVS_CORE_VIEW_GEOMETRY_H_
-#define WILD_MVS_CORE_VIEW_GEOMETRY_H_
+#pragma once
 
 #include <vector>
 
@@ -26,5 +25,3 @@ bool AxesClosestApproachDepth(const Camera& a, const Camera& b, double min_sin2,
                               double* depth);
 
 }  // namespace wild_mvs
-
-#endif  // WILD_MVS_CORE_VIEW_GEOMETRY_H_

@@ -1,7 +1,6 @@
 // Copyright wild_mvs authors. JSON text of the per-view reconstruction
 // report (OUT/log/<stem>.json): written by the I/O layer, not the core.
-#ifndef WILD_MVS_IO_REPORT_JSON_H_
-#define WILD_MVS_IO_REPORT_JSON_H_
+#pragma once
 
 #include <string>
 
@@ -17,5 +16,3 @@ namespace wild_mvs {
 std::string ViewReportJson(const ViewReport& report, const Scene& scene);
 
 }  // namespace wild_mvs
-
-#endif  // WILD_MVS_IO_REPORT_JSON_H_
