@@ -24,6 +24,7 @@
 #include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/colmap.h"
 #include "wild_mvs/io/depth_map_io.h"
+#include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/preview.h"
 
 using namespace wild_mvs;

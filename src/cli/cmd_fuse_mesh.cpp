@@ -8,6 +8,7 @@
 #include "wild_mvs/cli/run_steps.h"
 #include "wild_mvs/cli/scene_setup.h"
 #include "wild_mvs/cli/specs.h"
+#include "wild_mvs/io/image_files.h"
 
 namespace wild_mvs {
 namespace cli {

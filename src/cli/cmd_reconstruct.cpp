@@ -17,6 +17,7 @@
 #include "wild_mvs/cli/scene_setup.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/image_files.h"
 
 namespace wild_mvs {
 namespace cli {

@@ -18,6 +18,7 @@
 #include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/depth_map_io.h"
+#include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/report_json.h"
 
 namespace wild_mvs {
@@ -185,7 +186,7 @@ DepthStageResult RunDepthStage(const Scene& scene,
     DepthMap map;
     ViewReport report;
     try {
-      const cv::Mat mask = LoadMaskForView(view);
+      const cv::Mat mask = LoadViewMask(view);
       map = ReconstructView(scene, v, images, config.mvs, pool, &report, mask);
     } catch (const Error& e) {
       r.failures.push_back(Msg(view.name, ": ", e.what()));
