@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/colmap.h"
 #include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/ground_truth.h"
@@ -38,14 +39,6 @@ struct Totals {
   long long gt_valid = 0, evaluated = 0, within1 = 0, within2 = 0;
   std::vector<float> errors;
 };
-
-// Median of v (reorders it); 0 when empty.
-double Median(std::vector<float>* v) {
-  if (v->empty()) return 0;
-  const size_t m = v->size() / 2;
-  std::nth_element(v->begin(), v->begin() + m, v->end());
-  return (*v)[m];
-}
 
 }  // namespace
 
@@ -149,7 +142,7 @@ int main(int argc, char** argv) {
         const double ev = std::max<long long>(1, t.evaluated);
         std::printf(" %8.3f %7.3f %7.3f %9.4f",
                     t.evaluated / std::max(1.0, double(t.gt_valid)),
-                    t.within1 / ev, t.within2 / ev, Median(&t.errors));
+                    t.within1 / ev, t.within2 / ev, Median(t.errors));
       }
       std::printf("\n");
       tot.samples += t.samples;
@@ -172,7 +165,7 @@ int main(int argc, char** argv) {
           " gt_completeness=%.4f within_1cm=%.4f within_2cm=%.4f "
           "median_error_m=%.5f",
           tot.evaluated / std::max(1.0, double(tot.gt_valid)), tot.within1 / ev,
-          tot.within2 / ev, Median(&tot.errors));
+          tot.within2 / ev, Median(tot.errors));
     }
     std::printf("\n");
   } catch (const std::exception& e) {

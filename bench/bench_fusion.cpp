@@ -11,8 +11,6 @@
 //     writes N analytic depth maps (sphere on a ground square, ring cameras,
 //     0.2 % depth noise, 5 % outliers; default 640 x 480 like templeRing) to
 //     OUT in the same layout, for runs before real depth maps exist.
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -26,25 +24,13 @@
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/scene.h"
+#include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/depth_map_io.h"
 
 namespace fs = std::filesystem;
 using namespace wild_mvs;  // NOLINT
 
 namespace {
-
-double CpuSeconds() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec +
-         1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
-double PeakRssMb() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return ru.ru_maxrss / 1024.0;  // kilobytes on Linux
-}
 
 int MakeSynthetic(const std::string& out, int n, int w, int h) {
   fusion_test::AnalyticScene scene;

@@ -10,8 +10,6 @@
 // Runs ReconstructView on each view (one view at a time, every thread of the
 // pool inside the view) and prints per view and in total: valid samples,
 // wall seconds, CPU seconds, samples per CPU second, peak RSS.
-#include <sys/resource.h>
-
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -23,17 +21,13 @@
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/reconstruct_view.h"
+#include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/colmap.h"
 #include "wild_mvs/io/depth_map_io.h"
+#include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/preview.h"
 
 using namespace wild_mvs;
-
-static double PeakRssMb() {
-  rusage ru;
-  getrusage(RUSAGE_SELF, &ru);
-  return ru.ru_maxrss / 1024.0;
-}
 
 int main(int argc, char** argv) {
   if (argc < 3) {

@@ -16,6 +16,7 @@
 #include "wild_mvs/core/thread_pool.h"
 #include "wild_mvs/core/triangulation.h"
 #include "wild_mvs/io/dataset.h"
+#include "wild_mvs/io/image_files.h"
 
 using Clock = std::chrono::steady_clock;
 

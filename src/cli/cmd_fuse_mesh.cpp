@@ -4,9 +4,11 @@
 #include <iostream>
 
 #include "wild_mvs/cli/commands.h"
+#include "wild_mvs/cli/option_command.h"
 #include "wild_mvs/cli/run_steps.h"
 #include "wild_mvs/cli/scene_setup.h"
 #include "wild_mvs/cli/specs.h"
+#include "wild_mvs/io/image_files.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -14,37 +16,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Options of a reconstruct folder: defaults < OUT/run.yaml < --config <
-// flags. Returns false when there is no run record.
-bool LoadFolderOptions(const std::string& out, const Args& args,
-                       OptionSet* set) {
-  const bool has_record = fs::exists(RunRecordPath(out));
-  if (has_record) set->LoadYamlFile(RunRecordPath(out));
-  if (args.Has("config")) set->LoadYamlFile(args.Get("config"));
-  args.ApplyCoreAssignments(set);
-  return has_record;
-}
-
 }  // namespace
 
 int RunFuse(const CommandArgs& argv) {
   ReconstructConfig config;
   DatasetRecord record;
-  OptionSet options;
-  RegisterOptions(&config, &options);
-  const CommandSpec spec = FuseSpec();
-  Args args(spec, argv, &options);
-  if (args.help()) {
-    PrintCommandHelp(spec, &options, std::cout);
-    return 0;
-  }
+  OptionCommand command(FuseSpec(), argv, &config);
+  if (command.PrintHelpIfAsked(std::cout)) return 0;
+  const Args& args = command.args();
   const std::string out = args.positional(0);
   Require(fs::is_directory(out), out, ": not a folder");
-  OptionSet with_record;
-  RegisterOptions(&config, &with_record);
-  RegisterDatasetRecord(&record, &with_record);
-  const bool has_record = LoadFolderOptions(out, args, &with_record);
-  config.Check();
+  // Options: defaults < OUT/run.yaml < --config < flags.
+  const bool has_record = command.ConfigureWithRunRecord(out, &record);
   if (args.Has("dataset")) {
     record = DatasetRecord();
     record.path = args.Get("dataset");
@@ -79,21 +62,12 @@ int RunFuse(const CommandArgs& argv) {
 int RunMesh(const CommandArgs& argv) {
   ReconstructConfig config;
   DatasetRecord record;
-  OptionSet options;
-  RegisterOptions(&config, &options);
-  const CommandSpec spec = MeshSpec();
-  Args args(spec, argv, &options);
-  if (args.help()) {
-    PrintCommandHelp(spec, &options, std::cout);
-    return 0;
-  }
+  OptionCommand command(MeshSpec(), argv, &config);
+  if (command.PrintHelpIfAsked(std::cout)) return 0;
+  const Args& args = command.args();
   const std::string out = args.positional(0);
   Require(fs::is_directory(out), out, ": not a folder");
-  OptionSet with_record;
-  RegisterOptions(&config, &with_record);
-  RegisterDatasetRecord(&record, &with_record);
-  LoadFolderOptions(out, args, &with_record);
-  config.Check();
+  command.ConfigureWithRunRecord(out, &record);
   const std::string in = args.Get("input", out + "/fused.ply");
   const std::string ply = args.Get("output", out + "/mesh.ply");
   const PointCloud cloud = LoadFusedCloud(in);

@@ -14,18 +14,13 @@
 #include "wild_mvs/cli/commands.h"
 #include "wild_mvs/cli/scene_setup.h"
 #include "wild_mvs/cli/specs.h"
+#include "wild_mvs/core/stats.h"
 
 namespace wild_mvs {
 namespace cli {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 // A point the cameras look at: the median of the sparse points, else the
 // least-squares intersection of the optical axes.

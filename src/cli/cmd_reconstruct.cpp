@@ -4,20 +4,26 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "wild_mvs/cli/args.h"
 #include "wild_mvs/cli/commands.h"
+#include "wild_mvs/cli/option_command.h"
 #include "wild_mvs/cli/progress.h"
 #include "wild_mvs/cli/reconstruct_config.h"
 #include "wild_mvs/cli/run_steps.h"
 #include "wild_mvs/cli/scene_setup.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/image_files.h"
 
 namespace wild_mvs {
 namespace cli {
 namespace {
+
+namespace fs = std::filesystem;
 
 CommandSpec ReconstructSpec() {
   CommandSpec s;
@@ -70,110 +76,100 @@ CommandSpec ReconstructSpec() {
   return s;
 }
 
-}  // namespace
+// Applies --preset NAME to *config (before --config and the flags).
+void ApplyPreset(const Args& args, ReconstructConfig* config) {
+  if (!args.Has("preset")) return;
+  const std::string preset = args.Get("preset");
+  if (preset == "paper") {
+    config->mvs = PaperMvsOptions();
+  } else if (preset != "default") {
+    throw UsageError(
+        Msg("option --preset: unknown preset '", preset, "' (default, paper)"));
+  }
+}
 
-int RunReconstruct(const CommandArgs& argv) {
-  ReconstructConfig config;
-  OptionSet options;
-  RegisterOptions(&config, &options);
-  const CommandSpec spec = ReconstructSpec();
-  Args args(spec, argv, &options);
-  if (args.help()) {
-    PrintCommandHelp(spec, &options, std::cout);
-    return 0;
-  }
-  if (args.Has("preset")) {
-    const std::string preset = args.Get("preset");
-    if (preset == "paper") {
-      config.mvs = PaperMvsOptions();
-    } else if (preset != "default") {
-      throw UsageError(Msg("option --preset: unknown preset '", preset,
-                           "' (default, paper)"));
-    }
-  }
-  if (args.Has("config")) options.LoadYamlFile(args.Get("config"));
-  args.ApplyCoreAssignments(&options);
-  config.Check();
-  if (args.Has("dump-config")) {
-    std::cout << options.ToYaml(true);
-    return 0;
-  }
-  if (args.positionals().size() < 2) {
-    throw UsageError(Msg("missing argument ",
-                         args.positionals().empty() ? "DATASET OUT" : "OUT",
-                         " (usage: wild_mvs reconstruct ", spec.usage, ")"));
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  const double cpu0 = CpuSeconds();
-  const std::string out = args.positional(1);
-  const bool force = args.Has("force");
-  std::ostream& log = std::cerr;
-
-  // Output folder first: an unwritable OUT fails before any long work.
-  namespace fs = std::filesystem;
+// Output folder first: an unwritable OUT fails before any long work.
+void CreateOutputFolder(const std::string& out) {
   std::error_code ec;
   fs::create_directories(out, ec);
   Require(!ec && fs::is_directory(out), out,
           ": cannot create the output folder: ",
           ec ? ec.message() : std::string("not a folder"));
+}
 
+// The dataset of this run as recorded in OUT/run.yaml.
+DatasetRecord MakeDatasetRecord(const Args& args) {
   DatasetRecord record;
   record.path = fs::absolute(args.positional(0)).lexically_normal().string();
   record.model = args.Get("model");
   record.images = args.Get("images");
   record.format = args.Get("format", "auto");
   record.mask_dir = args.Get("mask-dir");
-  // Compare with the options of an earlier run in OUT (run.yaml): depth
-  // maps computed with other depth options are kept (resuming is the point)
-  // but the user is told; the cloud and the mesh are redone when their
-  // options (or their inputs) changed.
-  bool fusion_options_changed = true, mesh_options_changed = true;
-  if (fs::exists(RunRecordPath(out)) && !force) {
-    ReconstructConfig before;
-    DatasetRecord before_record;
-    OptionSet previous;
-    RegisterOptions(&before, &previous);
-    RegisterDatasetRecord(&before_record, &previous);
-    try {
-      previous.LoadYamlFile(RunRecordPath(out));
-      std::string depth_changes;
-      fusion_options_changed = mesh_options_changed = false;
-      for (size_t i = 0; i < options.options().size(); ++i) {
-        const auto& now = options.options()[i];
-        const auto& was = previous.options()[i];
-        if (now.Text() == was.Text()) continue;
-        if (now.key().rfind("run.", 0) == 0) continue;
-        if (now.key().rfind("fusion.", 0) == 0) {
-          fusion_options_changed = true;
-        } else if (now.key().rfind("meshing.", 0) == 0) {
-          mesh_options_changed = true;
-        } else {
-          depth_changes +=
-              Msg("\n    ", now.key(), ": ", was.Text(), " -> ", now.Text());
-        }
-      }
-      if (before_record.path != record.path) {
-        log << "warning: " << out << " holds results of another dataset ("
-            << before_record.path << "); views with the same names are "
-            << "treated as done (use --force or another OUT)\n";
-        fusion_options_changed = true;
-      }
-      if (!depth_changes.empty()) {
-        log << "note: " << RunRecordPath(out)
-            << ": finished depth maps were computed with other options; they "
-               "are kept (use --force to recompute):"
-            << depth_changes << "\n";
-      }
-    } catch (const Error& e) {
-      log << "note: ignoring the earlier run record: " << e.what() << "\n";
-      fusion_options_changed = mesh_options_changed = true;
-    }
-  }
-  OptionSet record_set;
-  ReconstructConfig record_config = config;
-  RegisterOptions(&record_config, &record_set);
-  RegisterDatasetRecord(&record, &record_set);
+  return record;
+}
 
+// Which results of an earlier run in OUT are out of date.
+struct EarlierRun {
+  bool fusion_options_changed = true, mesh_options_changed = true;
+};
+
+// Compares with the options of an earlier run in OUT (run.yaml): depth maps
+// computed with other depth options are kept (resuming is the point) but
+// the user is told; the cloud and the mesh are redone when their options
+// (or their inputs) changed.
+EarlierRun CompareWithEarlierRun(const std::string& out, bool force,
+                                 const OptionSet& options,
+                                 const DatasetRecord& record,
+                                 std::ostream& log) {
+  EarlierRun r;
+  if (!fs::exists(RunRecordPath(out)) || force) return r;
+  ReconstructConfig before;
+  DatasetRecord before_record;
+  OptionSet previous;
+  RegisterOptions(&before, &previous);
+  RegisterDatasetRecord(&before_record, &previous);
+  try {
+    previous.LoadYamlFile(RunRecordPath(out));
+    std::string depth_changes;
+    r.fusion_options_changed = r.mesh_options_changed = false;
+    for (size_t i = 0; i < options.options().size(); ++i) {
+      const auto& now = options.options()[i];
+      const auto& was = previous.options()[i];
+      if (now.Text() == was.Text()) continue;
+      if (now.key().rfind("run.", 0) == 0) continue;
+      if (now.key().rfind("fusion.", 0) == 0) {
+        r.fusion_options_changed = true;
+      } else if (now.key().rfind("meshing.", 0) == 0) {
+        r.mesh_options_changed = true;
+      } else {
+        depth_changes +=
+            Msg("\n    ", now.key(), ": ", was.Text(), " -> ", now.Text());
+      }
+    }
+    if (before_record.path != record.path) {
+      log << "warning: " << out << " holds results of another dataset ("
+          << before_record.path << "); views with the same names are "
+          << "treated as done (use --force or another OUT)\n";
+      r.fusion_options_changed = true;
+    }
+    if (!depth_changes.empty()) {
+      log << "note: " << RunRecordPath(out)
+          << ": finished depth maps were computed with other options; they "
+             "are kept (use --force to recompute):"
+          << depth_changes << "\n";
+    }
+  } catch (const Error& e) {
+    log << "note: ignoring the earlier run record: " << e.what() << "\n";
+    r.fusion_options_changed = r.mesh_options_changed = true;
+  }
+  return r;
+}
+
+// The dataset loaded, downscaled and masked; `views` the selected reference
+// views.
+Scene SetUpScene(const Args& args, const ReconstructConfig& config,
+                 const DatasetRecord& record, std::vector<int>* views,
+                 std::ostream& log) {
   DatasetOptions dopt = MakeDatasetOptions(args.positional(0), args);
   Scene scene = LoadDataset(dopt);
   const int scaled = LimitImageSize(&scene, config.image.max_image_size);
@@ -182,7 +178,7 @@ int RunReconstruct(const CommandArgs& argv) {
     log << "masks: " << masks << " of " << scene.views.size()
         << " views have a mask in " << record.mask_dir << "\n";
   }
-  const std::vector<int> views = SelectViews(scene, args.Get("views"));
+  *views = SelectViews(scene, args.Get("views"));
   log << "dataset: " << scene.views.size() << " views, " << scene.points.size()
       << " sparse points (" << scene.source << ")";
   if (scaled) {
@@ -190,61 +186,80 @@ int RunReconstruct(const CommandArgs& argv) {
         << config.image.max_image_size << " px";
   }
   log << "\n";
-  // Written before the long work so that `fuse OUT` works on partial runs;
-  // this also proves that OUT is writable.
+  return scene;
+}
+
+// OUT/run.yaml: the dataset and options of this folder.
+void WriteRunRecord(const std::string& out, const OptionSet& record_set) {
   WriteFileAtomically(RunRecordPath(out), [&](std::ostream& os) {
     os << "# wild_mvs reconstruct: the dataset and options of this folder "
           "(read by 'wild_mvs fuse' and 'wild_mvs mesh')\n"
        << record_set.ToYaml(false);
   });
+}
 
-  ThreadPool pool(config.run.threads);
-  ImageCache images(MakeSceneLoader(scene, config.image),
-                    config.image.cache_mb);
+// What the stages did.
+struct StageResults {
   DepthStageResult depth;
   bool depth_ran = false;
-  if (config.run.HasStage("depth")) {
-    int todo = 0;
-    for (int v : views) {
-      todo += (force || !ViewOutputsComplete(out, scene.views[v].Stem()));
-    }
-    if (todo > 0 && scene.points.empty()) {
-      ComputeSceneTracks(&scene, config, &pool, log);
-      WriteColmapText(scene, out + "/sparse");
-      log << "sparse: model written to " << out << "/sparse\n";
-    }
-    log << "depth: " << views.size() << " views, " << todo << " to compute, "
-        << pool.size() << " threads\n";
-    depth = RunDepthStage(scene, views, images, config, &pool, out, force, log);
-    depth_ran = true;
-    if (!depth.failures.empty()) {
-      std::string list;
-      for (const std::string& f : depth.failures) list += "\n  " + f;
-      throw Error(Msg(depth.failures.size(), " of ", views.size(),
-                      " views failed (the others are saved; fix the input "
-                      "and run again to resume):",
-                      list));
-    }
+  FuseResult fuse;
+  bool fused_now = false;
+  MeshResult mesh;
+  bool meshed = false;
+};
+
+// The depth stage (sparse tracks first when the dataset has none and some
+// view is to be computed). Throws when a view failed.
+void DepthStage(Scene* scene, const std::vector<int>& views, ImageCache& images,
+                const ReconstructConfig& config, ThreadPool* pool,
+                const std::string& out, bool force, StageResults* r,
+                std::ostream& log) {
+  int todo = 0;
+  for (int v : views) {
+    todo += (force || !ViewOutputsComplete(out, scene->views[v].Stem()));
   }
+  if (todo > 0 && scene->points.empty()) {
+    ComputeSceneTracks(scene, config, pool, log);
+    WriteColmapText(*scene, out + "/sparse");
+    log << "sparse: model written to " << out << "/sparse\n";
+  }
+  log << "depth: " << views.size() << " views, " << todo << " to compute, "
+      << pool->size() << " threads\n";
+  r->depth =
+      RunDepthStage(*scene, views, images, config, pool, out, force, log);
+  r->depth_ran = true;
+  if (!r->depth.failures.empty()) {
+    std::string list;
+    for (const std::string& f : r->depth.failures) list += "\n  " + f;
+    throw Error(Msg(r->depth.failures.size(), " of ", views.size(),
+                    " views failed (the others are saved; fix the input "
+                    "and run again to resume):",
+                    list));
+  }
+}
+
+// The fuse and mesh stages, each skipped when its output is up to date.
+void FuseAndMeshStages(const Scene& scene, ImageCache* images,
+                       const ReconstructConfig& config, ThreadPool* pool,
+                       const std::string& out, bool force,
+                       const EarlierRun& earlier, StageResults* r,
+                       std::ostream& log) {
   const std::string fused = out + "/fused.ply", mesh_path = out + "/mesh.ply";
   PointCloud cloud;
-  bool have_cloud = false, fused_now = false;
-  FuseResult fuse;
+  bool have_cloud = false;
   if (config.run.HasStage("fuse")) {
-    if (!force && depth.computed == 0 && !fusion_options_changed &&
+    if (!force && r->depth.computed == 0 && !earlier.fusion_options_changed &&
         fs::exists(fused)) {
       log << "fuse: " << fused
           << " is up to date, skipped (--force recomputes)\n";
     } else {
-      fuse =
-          RunFuseStage(scene, &images, config, &pool, out, fused, log, &cloud);
-      have_cloud = fused_now = true;
+      r->fuse =
+          RunFuseStage(scene, images, config, pool, out, fused, log, &cloud);
+      have_cloud = r->fused_now = true;
     }
   }
-  MeshResult mesh;
-  bool meshed = false;
   if (config.run.HasStage("mesh")) {
-    if (!force && !fused_now && !mesh_options_changed &&
+    if (!force && !r->fused_now && !earlier.mesh_options_changed &&
         fs::exists(mesh_path)) {
       log << "mesh: " << mesh_path
           << " is up to date, skipped (--force recomputes)\n";
@@ -254,36 +269,96 @@ int RunReconstruct(const CommandArgs& argv) {
                 ": no fused cloud to mesh (run the fuse stage first)");
         cloud = LoadFusedCloud(fused);
       }
-      mesh = RunMeshStage(cloud, config, mesh_path, log);
-      meshed = true;
+      r->mesh = RunMeshStage(cloud, config, mesh_path, log);
+      r->meshed = true;
     }
   }
+}
 
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
-          .count();
-  const double cpu = CpuSeconds() - cpu0;
+// The summary line on stdout and OUT/summary.json.
+void WriteSummary(const std::string& out, size_t views, const StageResults& r,
+                  double secs, double cpu, int threads) {
   std::ostringstream sum;
-  sum << "summary: " << views.size() << " views";
-  if (depth_ran) {
-    sum << " (" << depth.computed << " computed, " << depth.skipped
-        << " resumed), " << depth.samples << " valid depth samples";
+  sum << "summary: " << views << " views";
+  if (r.depth_ran) {
+    sum << " (" << r.depth.computed << " computed, " << r.depth.skipped
+        << " resumed), " << r.depth.samples << " valid depth samples";
   }
-  if (fused_now) sum << ", " << fuse.points << " points";
-  if (meshed) sum << ", " << mesh.faces << " faces";
+  if (r.fused_now) sum << ", " << r.fuse.points << " points";
+  if (r.meshed) sum << ", " << r.mesh.faces << " faces";
   sum << "; " << std::fixed << std::setprecision(1) << secs << " s, " << cpu
       << " CPU-s, peak RSS " << std::setprecision(0) << PeakRssMb() << " MB";
   std::cout << sum.str() << "\n";
   WriteFileAtomically(out + "/summary.json", [&](std::ostream& os) {
-    os << "{\n  \"views\": " << views.size()
-       << ",\n  \"views_computed\": " << depth.computed
-       << ",\n  \"views_resumed\": " << depth.skipped
-       << ",\n  \"valid_samples\": " << depth.samples
-       << ",\n  \"fused_points\": " << (fused_now ? fuse.points : 0)
-       << ",\n  \"mesh_faces\": " << (meshed ? mesh.faces : 0)
+    os << "{\n  \"views\": " << views
+       << ",\n  \"views_computed\": " << r.depth.computed
+       << ",\n  \"views_resumed\": " << r.depth.skipped
+       << ",\n  \"valid_samples\": " << r.depth.samples
+       << ",\n  \"fused_points\": " << (r.fused_now ? r.fuse.points : 0)
+       << ",\n  \"mesh_faces\": " << (r.meshed ? r.mesh.faces : 0)
        << ",\n  \"seconds\": " << secs << ",\n  \"cpu_seconds\": " << cpu
-       << ",\n  \"threads\": " << pool.size() << "\n}\n";
+       << ",\n  \"threads\": " << threads << "\n}\n";
   });
+}
+
+}  // namespace
+
+int RunReconstruct(const CommandArgs& argv) {
+  // Options: defaults < --preset < --config < flags.
+  ReconstructConfig config;
+  OptionCommand command(ReconstructSpec(), argv, &config);
+  if (command.PrintHelpIfAsked(std::cout)) return 0;
+  const Args& args = command.args();
+  ApplyPreset(args, &config);
+  command.Configure();
+  if (args.Has("dump-config")) {
+    std::cout << command.options().ToYaml(true);
+    return 0;
+  }
+  if (args.positionals().size() < 2) {
+    throw UsageError(Msg(
+        "missing argument ", args.positionals().empty() ? "DATASET OUT" : "OUT",
+        " (usage: wild_mvs reconstruct ", command.spec().usage, ")"));
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = CpuSeconds();
+  const std::string out = args.positional(1);
+  const bool force = args.Has("force");
+  std::ostream& log = std::cerr;
+
+  // Output folder and run record.
+  CreateOutputFolder(out);
+  DatasetRecord record = MakeDatasetRecord(args);
+  const EarlierRun earlier =
+      CompareWithEarlierRun(out, force, command.options(), record, log);
+  OptionSet record_set;
+  ReconstructConfig record_config = config;
+  RegisterOptions(&record_config, &record_set);
+  RegisterDatasetRecord(&record, &record_set);
+
+  // Scene.
+  std::vector<int> views;
+  Scene scene = SetUpScene(args, config, record, &views, log);
+  // Written before the long work so that `fuse OUT` works on partial runs;
+  // this also proves that OUT is writable.
+  WriteRunRecord(out, record_set);
+
+  // Stages.
+  ThreadPool pool(config.run.threads);
+  ImageCache images(MakeSceneLoader(scene, config.image),
+                    config.image.cache_mb);
+  StageResults results;
+  if (config.run.HasStage("depth")) {
+    DepthStage(&scene, views, images, config, &pool, out, force, &results, log);
+  }
+  FuseAndMeshStages(scene, &images, config, &pool, out, force, earlier,
+                    &results, log);
+
+  const double secs =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
+          .count();
+  WriteSummary(out, views.size(), results, secs, CpuSeconds() - cpu0,
+               pool.size());
   return 0;
 }
 

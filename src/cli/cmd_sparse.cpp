@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "wild_mvs/cli/commands.h"
+#include "wild_mvs/cli/option_command.h"
 #include "wild_mvs/cli/reconstruct_config.h"
 #include "wild_mvs/cli/run_steps.h"
 #include "wild_mvs/cli/scene_setup.h"
@@ -14,17 +15,10 @@ namespace cli {
 
 int RunSparse(const CommandArgs& argv) {
   ReconstructConfig config;
-  OptionSet options;
-  RegisterOptions(&config, &options);
-  const CommandSpec spec = SparseSpec();
-  Args args(spec, argv, &options);
-  if (args.help()) {
-    PrintCommandHelp(spec, &options, std::cout);
-    return 0;
-  }
-  if (args.Has("config")) options.LoadYamlFile(args.Get("config"));
-  args.ApplyCoreAssignments(&options);
-  config.Check();
+  OptionCommand command(SparseSpec(), argv, &config);
+  if (command.PrintHelpIfAsked(std::cout)) return 0;
+  command.Configure();
+  const Args& args = command.args();
 
   const auto start = std::chrono::steady_clock::now();
   const std::string out_dir = args.positional(1);

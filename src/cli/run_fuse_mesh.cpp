@@ -14,6 +14,7 @@
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/meshing.h"
 #include "wild_mvs/io/depth_map_io.h"
+#include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/ply.h"
 
 namespace wild_mvs {
@@ -82,7 +83,7 @@ FuseResult RunFuseStage(const Scene& scene, ImageCache* images,
   if (images) {
     image = [images](int v) { return *images->Get(v); };
   }
-  MaskProvider mask = [&](int v) { return LoadMaskForView(scene.views[v]); };
+  MaskProvider mask = [&](int v) { return LoadViewMask(scene.views[v]); };
   StreamingFusion fusion(config.fusion, depth, image, mask, pool);
   for (int v : views) {
     progress.Begin(scene.views[v].Stem());

@@ -1,8 +1,6 @@
 // Copyright wild_mvs authors.
 #include "wild_mvs/cli/run_steps.h"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -17,8 +15,11 @@
 #include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/sparse_tracker.h"
+#include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/depth_map_io.h"
+#include "wild_mvs/io/image_files.h"
+#include "wild_mvs/io/report_json.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -29,12 +30,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 std::string LogPath(const std::string& out, const std::string& stem) {
@@ -71,19 +66,6 @@ long long SamplesFromLog(const std::string& path) {
 }
 
 }  // namespace
-
-double CpuSeconds() {
-  rusage u;
-  if (getrusage(RUSAGE_SELF, &u) != 0) return 0;
-  return u.ru_utime.tv_sec + u.ru_stime.tv_sec +
-         1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-double PeakRssMb() {
-  rusage u;
-  if (getrusage(RUSAGE_SELF, &u) != 0) return 0;
-  return u.ru_maxrss / 1024.0;  // Linux: kilobytes
-}
 
 SparseSummary ComputeSceneTracks(Scene* scene, const ReconstructConfig& config,
                                  ThreadPool* pool, std::ostream& log) {
@@ -204,7 +186,7 @@ DepthStageResult RunDepthStage(const Scene& scene,
     DepthMap map;
     ViewReport report;
     try {
-      const cv::Mat mask = LoadMaskForView(view);
+      const cv::Mat mask = LoadViewMask(view);
       map = ReconstructView(scene, v, images, config.mvs, pool, &report, mask);
     } catch (const Error& e) {
       r.failures.push_back(Msg(view.name, ": ", e.what()));
@@ -219,7 +201,8 @@ DepthStageResult RunDepthStage(const Scene& scene,
         names.push_back(scene.views[n].name);
       }
     }
-    WriteViewOutputs(scene, view, raw, map, names, report.ToJson(scene), "");
+    WriteViewOutputs(scene, view, raw, map, names,
+                     ViewReportJson(report, scene), "");
     const int valid = map.CountValid();
     if (filter) {
       to_filter.push_back(v);

@@ -3,8 +3,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <set>
 
 namespace wild_mvs {
@@ -61,51 +59,6 @@ int LimitImageSize(Scene* scene, int max_size) {
     }
   }
   return changed;
-}
-
-int AssignMasks(Scene* scene, const std::string& dir) {
-  std::error_code ec;
-  Require(fs::is_directory(dir, ec), dir, ": mask folder does not exist");
-  int found = 0;
-  for (View& v : scene->views) {
-    const std::string candidates[] = {dir + "/" + v.name + ".png",
-                                      dir + "/" + v.Stem() + ".png",
-                                      dir + "/" + v.name};
-    for (const std::string& c : candidates) {
-      if (fs::is_regular_file(c, ec)) {
-        v.mask_path = c;
-        ++found;
-        break;
-      }
-    }
-  }
-  Require(
-      found > 0, dir,
-      ": no mask found for any view (expected "
-      "<image name>.png or <image stem>.png, e.g. ",
-      scene->views.empty() ? std::string("?") : scene->views[0].Stem() + ".png",
-      ")");
-  return found;
-}
-
-cv::Mat LoadMaskForView(const View& v) {
-  if (v.mask_path.empty()) return cv::Mat();
-  cv::Mat m = cv::imread(v.mask_path, cv::IMREAD_GRAYSCALE);
-  Require(!m.empty(), v.mask_path, ": cannot read mask image");
-  const int fw = v.file_width > 0 ? v.file_width : v.camera.width;
-  const int fh = v.file_height > 0 ? v.file_height : v.camera.height;
-  const bool camera_size =
-      m.cols == v.camera.width && m.rows == v.camera.height;
-  Require(camera_size || (m.cols == fw && m.rows == fh), v.mask_path,
-          ": mask is ", m.cols, "x", m.rows, " but image '", v.name, "' is ",
-          fw, "x", fh);
-  if (!camera_size) {
-    cv::Mat small;
-    cv::resize(m, small, cv::Size(v.camera.width, v.camera.height), 0, 0,
-               cv::INTER_NEAREST);
-    m = small;
-  }
-  return m;
 }
 
 std::vector<int> SelectViews(const Scene& scene, const std::string& list) {

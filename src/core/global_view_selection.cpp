@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/stats.h"
+#include "wild_mvs/core/view_geometry.h"
 
 namespace wild_mvs {
 namespace {
@@ -23,13 +25,6 @@ double ResolutionWeight(double r) {
   if (r >= 2) return 2.0 / r;
   if (r >= 1) return 1.0;
   return r;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
 }
 
 double Percentile(std::vector<double> v, double q) {
@@ -107,18 +102,12 @@ double EstimateSceneDepth(const Scene& scene, int ref,
   }
   if (depths.empty()) {
     // Closest approach of the optical axes of R and each other view.
-    const Eigen::Vector3d c0 = cr.Center(), d0 = cr.ViewDirection();
     for (size_t v = 0; v < scene.views.size(); ++v) {
       if (static_cast<int>(v) == ref) continue;
-      const Camera& cv = scene.views[v].camera;
-      const Eigen::Vector3d c1 = cv.Center(), d1 = cv.ViewDirection();
-      const Eigen::Vector3d w = c0 - c1;
-      const double b = d0.dot(d1), d = d0.dot(w), e = d1.dot(w);
-      const double den = 1 - b * b;
-      if (den < 1e-6) continue;            // parallel axes
-      const double s = (b * e - d) / den;  // along R's axis
-      const double u = (e - b * d) / den;  // along V's axis
-      if (s > 0 && u > 0) depths.push_back(s);
+      double s;
+      if (AxesClosestApproachDepth(cr, scene.views[v].camera, 1e-6, &s)) {
+        depths.push_back(s);
+      }
     }
   }
   if (depths.empty()) {
@@ -150,17 +139,7 @@ GlobalViewSelection SelectViewsByFrustumOverlap(
     if (angle < options.min_baseline_deg ||
         angle > options.fallback_max_baseline_deg)
       continue;
-    int inside = 0, total = 0;
-    for (int gy = 0; gy < 6; ++gy)
-      for (int gx = 0; gx < 8; ++gx) {
-        const Eigen::Vector2d px((gx + 0.5) * cr.width / 8.0,
-                                 (gy + 0.5) * cr.height / 6.0);
-        Eigen::Vector2d q;
-        ++total;
-        if (cv.Project(cr.Backproject(px, scene_depth), &q) && cv.InImage(q))
-          ++inside;
-      }
-    const double overlap = static_cast<double>(inside) / total;
+    const double overlap = FrustumGridOverlap(cr, cv, {scene_depth});
     const double r = FeatureScale(cr, X0) / FeatureScale(cv, X0);
     const double score =
         overlap * ParallaxWeight(dR, dV, options.max_parallax_deg * kDeg) *

@@ -3,8 +3,6 @@
 
 #include <array>
 #include <cmath>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "wild_mvs/core/error.h"
@@ -96,49 +94,6 @@ cv::Mat ToLinearRgb(const cv::Mat& in, bool linearize) {
   return out;
 }
 
-cv::Mat LoadViewImage(const View& view, const ImageOptions& options) {
-  Require(!view.image_path.empty(), "image '", view.name,
-          "': no image file is known for this view");
-  cv::Mat raw = cv::imread(
-      view.image_path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
-  Require(!raw.empty(), view.image_path,
-          ": cannot read image (missing, truncated or not an image)");
-  const Camera& cam = view.camera;
-  const int fw = view.file_width > 0 ? view.file_width : cam.width;
-  const int fh = view.file_height > 0 ? view.file_height : cam.height;
-  Require(raw.cols == fw && raw.rows == fh, view.image_path, ": image is ",
-          raw.cols, "x", raw.rows, " but its camera says ", fw, "x", fh);
-  if (!view.distortion.IsNone()) {
-    // Distortion parameters refer to the file's resolution.
-    const Camera fc = cam.Resized(fw, fh);
-    // OpenCV puts the top-left pixel centre at (0, 0): shift by 0.5.
-    cv::Mat K = (cv::Mat_<double>(3, 3) << fc.fx, 0, fc.cx - 0.5, 0, fc.fy,
-                 fc.cy - 0.5, 0, 0, 1);
-    const Distortion& d = view.distortion;
-    cv::Mat dist = (cv::Mat_<double>(1, 5) << d.k1, d.k2, d.p1, d.p2, d.k3);
-    cv::Mat und;
-    cv::undistort(raw, und, K, dist, K);
-    raw = und;
-  }
-  if (raw.cols != cam.width || raw.rows != cam.height) {
-    cv::Mat small;
-    cv::resize(raw, small, cv::Size(cam.width, cam.height), 0, 0,
-               cv::INTER_AREA);
-    raw = small;
-  }
-  return ToLinearRgb(raw, options.linearize);
-}
-
-cv::Mat LoadViewMask(const View& view) {
-  if (view.mask_path.empty()) return cv::Mat();
-  cv::Mat m = cv::imread(view.mask_path, cv::IMREAD_GRAYSCALE);
-  Require(!m.empty(), view.mask_path, ": cannot read mask image");
-  Require(m.cols == view.camera.width && m.rows == view.camera.height,
-          view.mask_path, ": mask is ", m.cols, "x", m.rows, " but image '",
-          view.name, "' is ", view.camera.width, "x", view.camera.height);
-  return m;
-}
-
 ImageCache::ImageCache(Loader loader, double capacity_mb)
     : loader_(std::move(loader)),
       capacity_bytes_(static_cast<size_t>(capacity_mb * 1024.0 * 1024.0)) {}
@@ -197,16 +152,6 @@ size_t ImageCache::bytes() const {
 size_t ImageCache::peak_bytes() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return peak_bytes_;
-}
-
-ImageCache::Loader MakeSceneLoader(const Scene& scene,
-                                   const ImageOptions& options) {
-  const Scene* s = &scene;
-  return [s, options](int view) {
-    Require(view >= 0 && view < static_cast<int>(s->views.size()),
-            "image cache: no view ", view);
-    return LoadViewImage(s->views[view], options);
-  };
 }
 
 }  // namespace wild_mvs

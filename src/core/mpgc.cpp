@@ -234,41 +234,31 @@ int PatchMatcher::FreeSlot() const {
   return -1;  // unreachable: at most kMaxActive are active
 }
 
-// Local view selection: fills A up to m views. Entering views are sampled
-// (values only) and get their NCC and initial colour scales. Returns the
-// number of views that entered.
+// Local view selection (FillActiveSet, local_view_selection.h): fills A up
+// to m views. Entering views are sampled (values only) and get their NCC and
+// initial colour scales. Returns the number of views that entered.
 int PatchMatcher::FillActive() {
-  int entered = 0;
   const int nv = static_cast<int>(ctx_.views.size());
-  while (num_active_ < local_.num_active) {
-    const int v = PickNextView(nv, global_scores_, epi_dir_, state_, active_,
-                               num_active_, max_angle_rad_);
-    if (v < 0) break;
-    const int slot = FreeSlot();
-    PrepareView(v, slot);
-    if (!SampleSlot(slot, false)) {
-      state_[v] = 2;
-      Note(iteration_, MatchTrace::Kind::kRefused, v);
-      continue;
-    }
-    const double ncc = SlotNcc(slot);
-    if (local_.enabled && ncc < local_.min_ncc) {
-      state_[v] = 2;
-      Note(iteration_, MatchTrace::Kind::kRefused, v);
-      continue;
-    }
-    SlotData& sl = slots_[slot];
-    sl.ncc = ncc;
-    sl.prev_ncc = std::numeric_limits<double>::quiet_NaN();
-    InitScales(slot);
-    state_[v] = 1;
-    Note(iteration_, MatchTrace::Kind::kEntered, v);
-    active_[num_active_] = v;
-    active_slot_[num_active_] = slot;
-    ++num_active_;
-    ++entered;
-  }
-  return entered;
+  int slot = -1;
+  return FillActiveSet(
+      local_, nv, global_scores_, epi_dir_, max_angle_rad_, state_, active_,
+      &num_active_,
+      [&](int v, double* ncc) {
+        slot = FreeSlot();
+        PrepareView(v, slot);
+        if (!SampleSlot(slot, false)) return false;
+        *ncc = SlotNcc(slot);
+        return true;
+      },
+      [&](int v, double ncc, int a) {
+        SlotData& sl = slots_[slot];
+        sl.ncc = ncc;
+        sl.prev_ncc = std::numeric_limits<double>::quiet_NaN();
+        InitScales(slot);
+        Note(iteration_, MatchTrace::Kind::kEntered, v);
+        active_slot_[a] = slot;
+      },
+      [&](int v) { Note(iteration_, MatchTrace::Kind::kRefused, v); });
 }
 
 void PatchMatcher::RemoveActive(int a) {

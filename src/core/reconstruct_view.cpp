@@ -7,7 +7,6 @@
 #include <cmath>
 #include <memory>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <unordered_set>
 
 #include "wild_mvs/core/error.h"
@@ -43,43 +42,6 @@ MvsOptions PaperMvsOptions() {
 
 namespace {
 
-std::string JsonEscape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '"':
-        o += "\\\"";
-        break;
-      case '\\':
-        o += "\\\\";
-        break;
-      case '\n':
-        o += "\\n";
-        break;
-      case '\t':
-        o += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          snprintf(buf, sizeof(buf), "\\u%04x", c);
-          o += buf;
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o;
-}
-
-std::string JsonNumber(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
 // A matching copy of an image: contiguous interleaved float, RGB or grey.
 struct OwnedImage {
   std::shared_ptr<const cv::Mat> rgb;  // keeps the cache entry alive
@@ -114,34 +76,6 @@ OwnedImage MakeMatchImage(std::shared_ptr<const cv::Mat> img, bool color) {
 }
 
 }  // namespace
-
-std::string ViewReport::ToJson(const Scene& scene) const {
-  std::ostringstream os;
-  auto name = [&](int v) {
-    return (v >= 0 && v < static_cast<int>(scene.views.size()))
-               ? scene.views[v].name
-               : std::string("?");
-  };
-  os << "{\n  \"neighbors\": [";
-  for (size_t i = 0; i < neighbors.size(); ++i) {
-    os << (i ? ", " : "") << "{\"view\": \"" << JsonEscape(name(neighbors[i]))
-       << "\", \"score\": "
-       << JsonNumber(i < neighbor_scores.size() ? neighbor_scores[i] : 0)
-       << ", \"scale\": " << JsonNumber(i < scales.size() ? scales[i] : 0)
-       << "}";
-  }
-  os << "],\n  \"working_scale\": " << JsonNumber(working_scale)
-     << ",\n  \"width\": " << width << ",\n  \"height\": " << height
-     << ",\n  \"seeds_tried\": " << seeds_tried
-     << ",\n  \"seeds_accepted\": " << seeds_accepted
-     << ",\n  \"samples\": " << samples
-     << ",\n  \"pixel_visits\": " << pixel_visits << ",\n  \"fallbacks\": [";
-  for (size_t i = 0; i < fallbacks.size(); ++i)
-    os << (i ? ", " : "") << "\"" << JsonEscape(fallbacks[i]) << "\"";
-  os << "],\n  \"seconds\": " << JsonNumber(seconds)
-     << ",\n  \"cpu_seconds\": " << JsonNumber(cpu_seconds) << "\n}\n";
-  return os.str();
-}
 
 DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
                          const MvsOptions& options, ThreadPool* pool,

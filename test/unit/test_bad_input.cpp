@@ -25,6 +25,7 @@
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/pfm.h"
 
 namespace fs = std::filesystem;

@@ -14,6 +14,7 @@
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/core/thread_pool.h"
 #include "wild_mvs/core/triangulation.h"
+#include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/middlebury.h"
 
 namespace wild_mvs {

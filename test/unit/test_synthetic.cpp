@@ -13,6 +13,7 @@
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/pfm.h"
 
 namespace wild_mvs {

@@ -14,15 +14,13 @@
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/core/point_cloud.h"
 #include "wild_mvs/core/scene.h"
+#include "wild_mvs/core/stats.h"
 #include "wild_mvs/core/thread_pool.h"
 
 namespace wild_mvs {
 namespace cli {
 
-// Process CPU time (user + system) in seconds, all threads.
-double CpuSeconds();
-// Peak resident set size of the process in MB.
-double PeakRssMb();
+// CpuSeconds() and PeakRssMb(): wild_mvs/core/stats.h.
 
 struct SparseSummary {
   size_t points = 0, observations = 0;

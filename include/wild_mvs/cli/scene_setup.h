@@ -9,6 +9,7 @@
 #include "wild_mvs/cli/args.h"
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/io/dataset.h"
+#include "wild_mvs/io/image_files.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -23,16 +24,7 @@ DatasetOptions MakeDatasetOptions(const std::string& path, const Args& args);
 // the number of views changed.
 int LimitImageSize(Scene* scene, int max_size);
 
-// Sets View::mask_path from `dir`: for image NAME (stem S) the first of
-// DIR/NAME.png (COLMAP's convention), DIR/S.png, DIR/NAME that exists.
-// Returns the number of views that got a mask; throws Error naming `dir`
-// when it is not a folder or no view has a mask in it.
-int AssignMasks(Scene* scene, const std::string& dir);
-
-// The view's mask (CV_8U, 0 = ignore) at its camera's resolution (a mask of
-// the image file's size is resized, nearest neighbour), or an empty Mat.
-// Throws Error naming the file when it is unreadable or of another size.
-cv::Mat LoadMaskForView(const View& view);
+// AssignMasks and LoadViewMask (the mask rule): wild_mvs/io/image_files.h.
 
 // Indices of the views named in a comma-separated list (image names or
 // stems); "" = all views. Throws UsageError naming an unknown entry.

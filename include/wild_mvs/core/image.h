@@ -1,4 +1,5 @@
-// Copyright wild_mvs authors. View images: loading, radiometry, bounded cache.
+// Copyright wild_mvs authors. View images: radiometry and a bounded cache.
+// (Reading them from files is the I/O layer's: wild_mvs/io/image_files.h.)
 //
 // Inside the core an image is a cv::Mat of type CV_32FC3, RGB channel order
 // (not OpenCV's BGR), linear radiometry (inverse sRGB applied once at load,
@@ -45,15 +46,8 @@ float LinearToSrgb(float v);
 // cv::imread into CV_32FC3 linear (or not) RGB in [0, 1].
 cv::Mat ToLinearRgb(const cv::Mat& bgr, bool linearize);
 
-// Loads a view's image from disk (8/16-bit, grey or colour; EXIF orientation
-// ignored), undistorts it when the view has lens distortion, checks that its
-// size matches the camera, and converts it with ToLinearRgb. Throws Error
-// naming the file and the problem (missing, unreadable, wrong size).
-cv::Mat LoadViewImage(const View& view, const ImageOptions& options);
-
-// Loads a view's mask (CV_8U, 0 = ignore) or returns an empty Mat when the
-// view has none. Throws Error when it is unreadable or of the wrong size.
-cv::Mat LoadViewMask(const View& view);
+// Reading images and masks from files (LoadViewImage, LoadViewMask,
+// MakeSceneLoader): wild_mvs/io/image_files.h.
 
 // Thread-safe LRU cache of view images, bounded in bytes. Images come from a
 // loader function, so algorithms never see file paths and tests can feed
@@ -84,9 +78,5 @@ class ImageCache {
   std::map<Key, decltype(lru_)::iterator> index_;
   size_t bytes_ = 0, peak_bytes_ = 0;
 };
-
-// A loader that reads scene views from disk with LoadViewImage.
-ImageCache::Loader MakeSceneLoader(const Scene& scene,
-                                   const ImageOptions& options);
 
 }  // namespace wild_mvs

@@ -41,4 +41,51 @@ int PickNextView(int num_views, const double* global_scores,
                  const Eigen::Vector2d* directions, const uint8_t* state,
                  const int* active, int num_active, double max_angle_rad);
 
+// The admission test: a candidate whose patch NCC with R is below min_ncc
+// does not enter A. Without local view selection (enabled = false, the
+// ablation) every view that could be sampled enters. A NaN NCC is not below
+// min_ncc.
+inline bool AdmitsView(const LocalViewSelectionOptions& options, double ncc) {
+  return !options.enabled || !(ncc < options.min_ncc);
+}
+
+// Candidate states in `state` (indices into the candidate arrays).
+constexpr uint8_t kCandidateUntried = 0, kCandidateActive = 1,
+                  kCandidateRejected = 2;
+
+// The fill loop of local view selection: while A (active[0, *num_active))
+// holds fewer than options.num_active views, picks the next candidate with
+// PickNextView and tries it. sample(v, &ncc) prepares candidate v, returns
+// false when its patch cannot be sampled and else sets ncc, its NCC with R.
+// A candidate that cannot be sampled or fails AdmitsView is rejected
+// (state kCandidateRejected, then refuse(v)); one that passes gets
+// enter(v, ncc, a) with a its index in A (before active[a] = v, state
+// kCandidateActive and ++*num_active). Returns the number of views that
+// entered.
+template <typename Sample, typename Enter, typename Refuse>
+int FillActiveSet(const LocalViewSelectionOptions& options, int num_views,
+                  const double* global_scores,
+                  const Eigen::Vector2d* directions, double max_angle_rad,
+                  uint8_t* state, int* active, int* num_active, Sample&& sample,
+                  Enter&& enter, Refuse&& refuse) {
+  int entered = 0;
+  while (*num_active < options.num_active) {
+    const int v = PickNextView(num_views, global_scores, directions, state,
+                               active, *num_active, max_angle_rad);
+    if (v < 0) break;
+    double ncc = 0;
+    if (!sample(v, &ncc) || !AdmitsView(options, ncc)) {
+      state[v] = kCandidateRejected;
+      refuse(v);
+      continue;
+    }
+    enter(v, ncc, *num_active);
+    state[v] = kCandidateActive;
+    active[*num_active] = v;
+    ++*num_active;
+    ++entered;
+  }
+  return entered;
+}
+
 }  // namespace wild_mvs

@@ -58,8 +58,7 @@ struct ViewReport {
   long long pixel_visits = 0;          // MPGC runs
   std::vector<std::string> fallbacks;  // "fallback: ..." notes
   double seconds = 0, cpu_seconds = 0;
-  // One JSON object (neighbours by name).
-  std::string ToJson(const Scene& scene) const;
+  // As JSON: ViewReportJson (wild_mvs/io/report_json.h).
 };
 
 // Reconstructs the depth map of view `ref`. images serves full-resolution

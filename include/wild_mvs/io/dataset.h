@@ -27,6 +27,8 @@
 #include <string>
 
 #include "wild_mvs/core/scene.h"
+// The images and masks of a loaded dataset are read with image_files.h.
+#include "wild_mvs/io/image_files.h"
 
 namespace wild_mvs {
 

@@ -1,0 +1,27 @@
+// Copyright wild_mvs authors. Small statistics and process measurements
+// shared by the core, the command-line tool and the benchmarks.
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+namespace wild_mvs {
+
+// The upper median of v (element v.size() / 2 in sorted order; no mean of
+// the two middle values); 0 when v is empty. Takes v by value (reorders the
+// copy); pass std::move(v) when v is no longer needed.
+template <typename T>
+double Median(std::vector<T> v) {
+  if (v.empty()) return 0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return static_cast<double>(v[m]);
+}
+
+// Process CPU time (user + system) in seconds, all threads; 0 when unknown.
+double CpuSeconds();
+
+// Peak resident set size of the process in MB; 0 when unknown.
+double PeakRssMb();
+
+}  // namespace wild_mvs
