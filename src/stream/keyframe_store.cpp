@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/stats.h"
 
 namespace wild_mvs {
 
@@ -59,12 +60,7 @@ double KeyframeStore::Usefulness(const Keyframe& k) const {
       steps.push_back((kf->camera.Center() - prev->camera.Center()).norm());
     prev = kf.get();
   }
-  double unit = 1.0;
-  if (!steps.empty()) {
-    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2,
-                     steps.end());
-    unit = std::max(steps[steps.size() / 2], 1e-9);
-  }
+  const double unit = steps.empty() ? 1.0 : std::max(Median(steps), 1e-9);
   const double distance =
       (k.camera.Center() - newest->camera.Center()).norm() / unit;
   const double angle =

@@ -11,20 +11,12 @@
 #include <memory>
 #include <string>
 
+#include "wild_mvs/core/stats.h"
+
 namespace wild_mvs {
 namespace ros1 {
 
 inline void RequestShutdownOnSignal(int) { ros::requestShutdown(); }
-
-// Peak resident memory of this process in MB (VmHWM), or -1.
-inline double PeakRssMb() {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind("VmHWM:", 0) == 0)
-      return std::atof(line.c_str() + 6) / 1024.0;
-  return -1;
-}
 
 // Runs node type T (constructed from the public and private node handles)
 // until SIGINT or SIGTERM, then destroys it (so its destructor runs: the
@@ -47,7 +39,7 @@ int RunNode(int argc, char** argv, const char* name) {
   ros::waitForShutdown();
   spinner.stop();
   node.reset();
-  std::fprintf(stderr, "%s: peak RSS %.0f MB\n", name, PeakRssMb());
+  std::fprintf(stderr, "%s: peak RSS %.0f MB\n", name, wild_mvs::PeakRssMb());
   return 0;
 }
 
