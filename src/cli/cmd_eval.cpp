@@ -15,6 +15,7 @@
 #include "wild_mvs/io/dataset.h"
 #include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/ground_truth.h"
+#include "wild_mvs/io/metrics_json.h"
 #include "wild_mvs/io/ply.h"
 
 namespace wild_mvs {
@@ -187,7 +188,7 @@ int EvalDepth(const Args& args) {
                         : std::string())
             << ":\n"
             << total.ToString();
-  std::string json = total.ToJson();
+  std::string json = DepthMetricsJson(total);
   if (with_cloud) {
     const PointCloud cloud = ReadCloudOrMeshVertices(args.Get("cloud"));
     Require(!cloud.empty(), args.Get("cloud"), ": the cloud is empty");
@@ -223,7 +224,7 @@ int EvalCloud(const Args& args) {
   Require(!gt.empty(), args.positional(2), ": the ground-truth cloud is empty");
   const CloudMetrics cm = EvaluateCloud(est, gt, opt);
   std::cout << cm.ToString();
-  WriteJson(args, cm.ToJson());
+  WriteJson(args, CloudMetricsJson(cm));
   return 0;
 }
 

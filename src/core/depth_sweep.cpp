@@ -8,14 +8,15 @@
 namespace wild_mvs {
 
 void DepthSweepOptions::Check() const {
-  Require(step >= 1, "sweep.step = ", step, " must be >= 1");
-  Require(num_depths >= 2, "sweep.num_depths = ", num_depths, " must be >= 2");
+  Require(step >= 1, "mvs.sweep.step = ", step, " must be >= 1");
+  Require(num_depths >= 2, "mvs.sweep.num_depths = ", num_depths,
+          " must be >= 2");
   Require(num_views >= 1 && num_views <= kMaxNeighbors,
-          "sweep.num_views = ", num_views, " must be in [1, ", kMaxNeighbors,
-          "]");
-  Require(min_score >= -1 && min_score <= 1, "sweep.min_score = ", min_score,
-          " must be in [-1, 1]");
-  Require(below_seeds >= 0, "sweep.below_seeds = ", below_seeds,
+          "mvs.sweep.num_views = ", num_views, " must be in [1, ",
+          kMaxNeighbors, "]");
+  Require(min_score >= -1 && min_score <= 1,
+          "mvs.sweep.min_score = ", min_score, " must be in [-1, 1]");
+  Require(below_seeds >= 0, "mvs.sweep.below_seeds = ", below_seeds,
           " must be >= 0");
 }
 

@@ -10,13 +10,13 @@ namespace wild_mvs {
 
 void GeometricConsistencyOptions::Check() const {
   Require(min_consistent >= 1 && min_consistent <= 32,
-          "consistency.min_consistent = ", min_consistent,
+          "mvs.consistency.min_consistent = ", min_consistent,
           " must be in [1, 32]");
   Require(max_reprojection_px > 0 && max_reprojection_px <= 100,
-          "consistency.max_reprojection_px = ", max_reprojection_px,
+          "mvs.consistency.max_reprojection_px = ", max_reprojection_px,
           " must be in (0, 100]");
   Require(max_relative_depth > 0 && max_relative_depth < 1,
-          "consistency.max_relative_depth = ", max_relative_depth,
+          "mvs.consistency.max_relative_depth = ", max_relative_depth,
           " must be in (0, 1)");
 }
 

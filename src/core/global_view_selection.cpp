@@ -38,16 +38,16 @@ double Percentile(std::vector<double> v, double q) {
 
 void GlobalViewSelectionOptions::Check() const {
   Require(num_neighbors >= 1 && num_neighbors <= 32,
-          "global.num_neighbors = ", num_neighbors, " must be in [1, 32]");
+          "mvs.global.num_neighbors = ", num_neighbors, " must be in [1, 32]");
   Require(max_parallax_deg > 0 && max_parallax_deg <= 90,
-          "global.max_parallax_deg = ", max_parallax_deg,
+          "mvs.global.max_parallax_deg = ", max_parallax_deg,
           " must be in (0, 90]");
   Require(min_baseline_deg >= 0 && min_baseline_deg < 45,
-          "global.min_baseline_deg = ", min_baseline_deg,
+          "mvs.global.min_baseline_deg = ", min_baseline_deg,
           " must be in [0, 45)");
   Require(fallback_max_baseline_deg > min_baseline_deg &&
               fallback_max_baseline_deg <= 180,
-          "global.fallback_max_baseline_deg = ", fallback_max_baseline_deg,
+          "mvs.global.fallback_max_baseline_deg = ", fallback_max_baseline_deg,
           " must be in (min_baseline_deg, 180]");
 }
 

@@ -10,12 +10,12 @@
 namespace wild_mvs {
 
 void LocalViewSelectionOptions::Check() const {
-  Require(num_active >= 1 && num_active <= 8, "local.num_active = ", num_active,
-          " must be in [1, 8]");
+  Require(num_active >= 1 && num_active <= 8,
+          "mvs.local.num_active = ", num_active, " must be in [1, 8]");
   Require(max_epipolar_angle_deg > 0 && max_epipolar_angle_deg <= 90,
-          "local.max_epipolar_angle_deg = ", max_epipolar_angle_deg,
+          "mvs.local.max_epipolar_angle_deg = ", max_epipolar_angle_deg,
           " must be in (0, 90]");
-  Require(min_ncc >= -1 && min_ncc <= 1, "local.min_ncc = ", min_ncc,
+  Require(min_ncc >= -1 && min_ncc <= 1, "mvs.local.min_ncc = ", min_ncc,
           " must be in [-1, 1]");
 }
 

@@ -54,28 +54,11 @@ double Mean(const std::vector<double>& v) {
   return s / static_cast<double>(v.size());
 }
 
-// JSON / text number formatting: shortest round-tripping-ish, inf -> null.
-std::string Num(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.9g", v);
-  return buf;
-}
-
 std::string Text(double v) {
   if (!std::isfinite(v)) return v > 0 ? "inf" : "nan";
   char buf[40];
   std::snprintf(buf, sizeof(buf), "%.6g", v);
   return buf;
-}
-
-std::string JsonArray(const std::vector<double>& v) {
-  std::string s = "[";
-  for (size_t k = 0; k < v.size(); ++k) {
-    if (k) s += ", ";
-    s += Num(v[k]);
-  }
-  return s + "]";
 }
 
 std::string Percent(double f) {
@@ -233,26 +216,6 @@ std::string DepthMetrics::ToString() const {
   return s;
 }
 
-std::string DepthMetrics::ToJson() const {
-  std::string s = "{";
-  s += "\"gt_valid\": " + std::to_string(gt_valid);
-  s += ", \"estimated\": " + std::to_string(estimated);
-  s += ", \"evaluated\": " + std::to_string(evaluated);
-  s += ", \"outside_gt\": " + std::to_string(outside_gt);
-  s += ", \"completeness\": " + Num(completeness);
-  s += ", \"median_abs_error\": " + Num(median_abs_error);
-  s += ", \"median_rel_error\": " + Num(median_rel_error);
-  s += ", \"mean_abs_error\": " + Num(mean_abs_error);
-  s += ", \"rmse\": " + Num(rmse);
-  s += ", \"relative_thresholds\": " + JsonArray(relative_thresholds);
-  s += ", \"relative_accuracy\": " + JsonArray(relative_accuracy);
-  s += ", \"relative_completeness\": " + JsonArray(relative_completeness);
-  s += ", \"absolute_thresholds\": " + JsonArray(absolute_thresholds);
-  s += ", \"absolute_accuracy\": " + JsonArray(absolute_accuracy);
-  s += ", \"absolute_completeness\": " + JsonArray(absolute_completeness);
-  return s + "}";
-}
-
 // ------------------------------------------------------------ clouds
 
 void CloudMetricsOptions::Check() const {
@@ -389,25 +352,6 @@ std::string CloudMetrics::ToString() const {
          ", recall/completeness " + Percent(recall[k]) + ", F-score " +
          Percent(fscore[k]) + "\n";
   return s;
-}
-
-std::string CloudMetrics::ToJson() const {
-  std::string s = "{";
-  s += "\"reconstruction_points\": " + std::to_string(reconstruction_points);
-  s += ", \"gt_points\": " + std::to_string(gt_points);
-  s += ", \"accuracy\": " + Num(accuracy);
-  s += ", \"accuracy_fraction\": " + Num(accuracy_fraction);
-  s += ", \"completeness_distance\": " + Num(completeness_distance);
-  s += ", \"mean_accuracy\": " + Num(mean_accuracy);
-  s += ", \"median_accuracy\": " + Num(median_accuracy);
-  s += ", \"mean_completeness\": " + Num(mean_completeness);
-  s += ", \"median_completeness\": " + Num(median_completeness);
-  s += ", \"taus\": " + JsonArray(taus);
-  s += ", \"precision\": " + JsonArray(precision);
-  s += ", \"recall\": " + JsonArray(recall);
-  s += ", \"completeness\": " + JsonArray(recall);
-  s += ", \"fscore\": " + JsonArray(fscore);
-  return s + "}";
 }
 
 }  // namespace wild_mvs

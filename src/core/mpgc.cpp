@@ -26,35 +26,35 @@ double LinearPerSrgb(double v) {
 
 void MpgcOptions::Check() const {
   Require(window >= 3 && window <= kMaxWindow && window % 2 == 1,
-          "mpgc.window = ", window, " must be odd and in [3, ", kMaxWindow,
+          "mvs.mpgc.window = ", window, " must be odd and in [3, ", kMaxWindow,
           "]");
   Require(settle_iterations >= 0,
-          "mpgc.settle_iterations = ", settle_iterations, " must be >= 0");
-  Require(drop_ncc >= -1 && drop_ncc <= 1, "mpgc.drop_ncc = ", drop_ncc,
+          "mvs.mpgc.settle_iterations = ", settle_iterations, " must be >= 0");
+  Require(drop_ncc >= -1 && drop_ncc <= 1, "mvs.mpgc.drop_ncc = ", drop_ncc,
           " must be in [-1, 1]");
-  Require(convergence_eps > 0, "mpgc.convergence_eps = ", convergence_eps,
+  Require(convergence_eps > 0, "mvs.mpgc.convergence_eps = ", convergence_eps,
           " must be > 0");
   Require(max_iterations > settle_iterations,
-          "mpgc.max_iterations = ", max_iterations,
-          " must exceed mpgc.settle_iterations = ", settle_iterations);
+          "mvs.mpgc.max_iterations = ", max_iterations,
+          " must exceed mvs.mpgc.settle_iterations = ", settle_iterations);
   Require(full_update_interval >= 1,
-          "mpgc.full_update_interval = ", full_update_interval,
+          "mvs.mpgc.full_update_interval = ", full_update_interval,
           " must be >= 1");
   Require(oscillation_iteration >= 0,
-          "mpgc.oscillation_iteration = ", oscillation_iteration,
+          "mvs.mpgc.oscillation_iteration = ", oscillation_iteration,
           " must be >= 0");
-  Require(min_facing >= 0 && min_facing < 1, "mpgc.min_facing = ", min_facing,
-          " must be in [0, 1)");
-  Require(accept_ncc >= -1 && accept_ncc <= 1, "mpgc.accept_ncc = ", accept_ncc,
-          " must be in [-1, 1]");
+  Require(min_facing >= 0 && min_facing < 1,
+          "mvs.mpgc.min_facing = ", min_facing, " must be in [0, 1)");
+  Require(accept_ncc >= -1 && accept_ncc <= 1,
+          "mvs.mpgc.accept_ncc = ", accept_ncc, " must be in [-1, 1]");
   Require(min_texture_levels >= 0 && min_texture_levels <= 64,
-          "mpgc.min_texture_levels = ", min_texture_levels,
+          "mvs.mpgc.min_texture_levels = ", min_texture_levels,
           " must be in [0, 64]");
   Require(normal_step_halvings >= 0 && normal_step_halvings <= 8,
-          "mpgc.normal_step_halvings = ", normal_step_halvings,
+          "mvs.mpgc.normal_step_halvings = ", normal_step_halvings,
           " must be in [0, 8]");
   Require(min_active_views >= 1 && min_active_views <= kMaxActive,
-          "mpgc.min_active_views = ", min_active_views, " must be in [1, ",
+          "mvs.mpgc.min_active_views = ", min_active_views, " must be in [1, ",
           kMaxActive, "]");
 }
 
@@ -66,8 +66,8 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
   Require(mpgc_.window == ctx_.window, "PatchMatcher: window ", mpgc_.window,
           " differs from the context's ", ctx_.window);
   Require(mpgc_.min_active_views <= local_.num_active,
-          "mpgc.min_active_views = ", mpgc_.min_active_views,
-          " must not exceed local.num_active = ", local_.num_active);
+          "mvs.mpgc.min_active_views = ", mpgc_.min_active_views,
+          " must not exceed mvs.local.num_active = ", local_.num_active);
   n_ = mpgc_.window;
   half_ = n_ / 2;
   npix_ = n_ * n_;

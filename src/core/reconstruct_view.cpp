@@ -24,8 +24,8 @@ void MvsOptions::Check() const {
   Require(max_image_size >= 0, "mvs.max_image_size = ", max_image_size,
           " must be >= 0 (0 = no limit)");
   Require(mpgc.min_active_views <= local.num_active,
-          "mpgc.min_active_views = ", mpgc.min_active_views,
-          " must not exceed local.num_active = ", local.num_active);
+          "mvs.mpgc.min_active_views = ", mpgc.min_active_views,
+          " must not exceed mvs.local.num_active = ", local.num_active);
 }
 
 MvsOptions PaperMvsOptions() {
@@ -205,7 +205,7 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
           : stats.seeds_accepted == 0 ? "no sparse feature could be matched"
                                       : Msg("only ", stats.seeds_accepted,
                                             " sparse features matched (< "
-                                            "sweep.below_seeds)");
+                                            "mvs.sweep.below_seeds)");
       rep.fallbacks.push_back(
           Msg("fallback: view '", scene.views[ref].name, "': ", why,
               "; seeded from a fronto-parallel depth sweep over [", lo, ", ",

@@ -17,12 +17,12 @@ namespace wild_mvs {
 
 void RegionGrowingOptions::Check() const {
   Require(tile_size >= 8 && tile_size <= 4096,
-          "growing.tile_size = ", tile_size, " must be in [8, 4096]");
+          "mvs.growing.tile_size = ", tile_size, " must be in [8, 4096]");
   Require(revisit_margin >= 0 && revisit_margin <= 2,
-          "growing.revisit_margin = ", revisit_margin,
+          "mvs.growing.revisit_margin = ", revisit_margin,
           " must be in [0, 2] (NCC units)");
   Require(hypotheses >= 0 && hypotheses <= 16,
-          "growing.hypotheses = ", hypotheses, " must be in [0, 16]");
+          "mvs.growing.hypotheses = ", hypotheses, " must be in [0, 16]");
 }
 
 double ThreadCpuSeconds() {

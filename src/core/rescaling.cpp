@@ -10,9 +10,10 @@
 namespace wild_mvs {
 
 void RescalingOptions::Check() const {
-  Require(min_scale > 0 && min_scale <= 1, "rescaling.min_scale = ", min_scale,
-          " must be in (0, 1]");
-  Require(max_scale >= 1, "rescaling.max_scale = ", max_scale, " must be >= 1");
+  Require(min_scale > 0 && min_scale <= 1,
+          "mvs.rescaling.min_scale = ", min_scale, " must be in (0, 1]");
+  Require(max_scale >= 1, "mvs.rescaling.max_scale = ", max_scale,
+          " must be >= 1");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,

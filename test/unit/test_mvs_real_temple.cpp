@@ -20,6 +20,7 @@
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/core/thread_pool.h"
 #include "wild_mvs/io/dataset.h"
+#include "wild_mvs/io/report_json.h"
 
 namespace wild_mvs {
 namespace {
@@ -99,7 +100,7 @@ TEST(MvsRealTemple, FiveViewsCorrectSamples) {
     std::printf("view %s: %d samples, %d of %d seeds, %.1f s; %s\n",
                 scene.views[ref].Stem().c_str(), rep.samples,
                 rep.seeds_accepted, rep.seeds_tried, rep.seconds,
-                rep.ToJson(scene).c_str());
+                ViewReportJson(rep, scene).c_str());
   }
   Counts total;
   for (size_t i = 0; i < maps.size(); ++i) {

@@ -63,8 +63,7 @@ struct DepthMetrics {
 
   // One human-readable line per quantity.
   std::string ToString() const;
-  // A JSON object (no trailing newline).
-  std::string ToJson() const;
+  // (JSON: io/metrics_json.h.)
 };
 
 // Scores `depth` against `gt`; both of the same size (throws Error naming the
@@ -121,8 +120,7 @@ struct CloudMetrics {
   std::vector<double> fscore;     // per tau
   const std::vector<double>& completeness() const { return recall; }
 
-  std::string ToString() const;
-  std::string ToJson() const;
+  std::string ToString() const;  // (JSON: io/metrics_json.h)
 };
 
 // Scores a reconstructed cloud against a ground-truth cloud. Throws Error
