@@ -31,7 +31,7 @@ source "$ROOT/scripts/common.sh"
 ASAN_BUILD_DIR="${FUZZ_BUILD_DIR:-$ROOT/build-fuzz}"
 TSAN_BUILD_DIR="${TSAN_BUILD_DIR:-$ROOT/build-tsan}"
 ASAN_TESTS="${ASAN_TESTS:-.}"
-ASAN_EXCLUDE="${ASAN_EXCLUDE:-^(_ctest_|ros_)}"
+ASAN_EXCLUDE="${ASAN_EXCLUDE:-^(_ctest_|ros_|config_files$)}"
 TSAN_TESTS="${TSAN_TESTS:-^test_(fusion|fusion_synthetic|mvs_end_to_end)(\.|_NOT_BUILT$)}"
 TSAN_EXCLUDE="${TSAN_EXCLUDE:-\.MvsEndToEnd\.(Ablations|VaryingLightingAndOccluder)$}"
 do_asan=1 do_tsan=0

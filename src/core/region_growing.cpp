@@ -111,8 +111,7 @@ class RegionGrower {
                const LocalViewSelectionOptions& local,
                const RegionGrowingOptions& options, const cv::Mat& mask,
                cv::Mat* depth, cv::Mat* normal, cv::Mat* confidence)
-      : ctx_(context),
-        cam_(context.ref_camera),
+      : cam_(context.ref_camera),
         opt_(options),
         matchers_(context, mpgc, local),
         W_(context.ref_image.width),
@@ -336,7 +335,6 @@ class RegionGrower {
     }
   }
 
-  const PatchContext& ctx_;
   const Camera& cam_;
   const RegionGrowingOptions& opt_;
   MatcherPool matchers_;
