@@ -114,8 +114,8 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
   // The light kinds draw the same random values; the single-factor kinds
   // (exposure, gamma, vignetting, sun) keep only one of the changes, to
   // isolate what costs coverage.
-  const bool light = kind == "light" || kind == "exposure" ||
-                     kind == "gamma" || kind == "vignetting" || kind == "sun";
+  const bool light = kind == "light" || kind == "exposure" || kind == "gamma" ||
+                     kind == "vignetting" || kind == "sun";
   if (light) {
     for (int i = 0; i < n; ++i) {
       testing::ViewLighting l, all;
@@ -163,9 +163,10 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::cerr << "usage: make_scene constant|light|exposure|gamma|vignetting|"
-                 "sun|clutter|scale OUT_DIR "
-                 "[--views N] [--width W] [--height H] [--seed S] [--points P]\n";
+    std::cerr
+        << "usage: make_scene constant|light|exposure|gamma|vignetting|"
+           "sun|clutter|scale OUT_DIR "
+           "[--views N] [--width W] [--height H] [--seed S] [--points P]\n";
     return 2;
   }
   try {
