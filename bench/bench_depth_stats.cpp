@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/metrics.h"
 #include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/colmap.h"
 #include "wild_mvs/io/depth_map_io.h"
@@ -117,19 +118,8 @@ int main(int argc, char** argv) {
               inside = inside && X[k] >= box[k] - margin &&
                        X[k] <= box[k + 3] + margin;
           bool agree = false;
-          for (size_t oj = 0; oj < maps.size() && !agree; ++oj) {
-            if (oj == mi) continue;
-            const DepthMap& o = maps[oj];
-            Eigen::Vector2d px;
-            if (!o.camera.Project(X, &px) || !o.camera.InImage(px)) continue;
-            const int ox = static_cast<int>(px.x()),
-                      oy = static_cast<int>(px.y());
-            if (ox < 0 || oy < 0 || ox >= o.depth.cols || oy >= o.depth.rows)
-              continue;
-            const float od = o.depth.at<float>(oy, ox);
-            const double z = o.camera.Depth(X);
-            agree = od > 0 && std::abs(od - z) <= rel * z;
-          }
+          for (size_t oj = 0; oj < maps.size() && !agree; ++oj)
+            agree = oj != mi && AgreesWithDepthMap(X, maps[oj], rel);
           if (inside) ++t.in_bbox;
           if (agree) ++t.consistent;
           if (inside && agree) ++t.correct;

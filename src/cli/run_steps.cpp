@@ -111,8 +111,8 @@ namespace {
 
 // Writes one view's depth map and its log (log last: the view is complete
 // once it exists). extra_json: more members for the log ("" = none).
-void WriteViewOutputs(const Scene& scene, const View& view,
-                      const std::string& dir, const DepthMap& map,
+void WriteViewOutputs(const View& view, const std::string& dir,
+                      const DepthMap& map,
                       const std::vector<std::string>& neighbor_names,
                       const std::string& json_body, const std::string& extra) {
   WriteDepthMapFiles(dir, view.Stem(), map, neighbor_names, true);
@@ -124,7 +124,6 @@ void WriteViewOutputs(const Scene& scene, const View& view,
   }
   WriteFileAtomically(LogPath(dir, view.Stem()),
                       [&](std::ostream& os) { os << json; });
-  (void)scene;
 }
 
 std::string ReadText(const std::string& path) {
@@ -201,8 +200,7 @@ DepthStageResult RunDepthStage(const Scene& scene,
         names.push_back(scene.views[n].name);
       }
     }
-    WriteViewOutputs(scene, view, raw, map, names,
-                     ViewReportJson(report, scene), "");
+    WriteViewOutputs(view, raw, map, names, ViewReportJson(report, scene), "");
     const int valid = map.CountValid();
     if (filter) {
       to_filter.push_back(v);
@@ -302,19 +300,15 @@ FilterStageResult FilterDepthMaps(const Scene& scene,
           Msg("\n  \"consistency\": {\"samples_before\": ", job.stats.samples,
               ", \"kept\": ", job.stats.kept,
               ", \"neighbor_maps\": ", job.neighbor_maps, "},");
-      WriteViewOutputs(scene, view, out, job.ref.map, job.ref.neighbor_names,
-                       StripViewHeader(ReadText(LogPath(raw, view.Stem()))),
+      // The raw log with the filtered count as its "samples" (written once:
+      // the log marks the view complete).
+      static const std::regex samples_re("\"samples\": [0-9]+");
+      const std::string body = std::regex_replace(
+          StripViewHeader(ReadText(LogPath(raw, view.Stem()))), samples_re,
+          Msg("\"samples\": ", job.stats.kept),
+          std::regex_constants::format_first_only);
+      WriteViewOutputs(view, out, job.ref.map, job.ref.neighbor_names, body,
                        extra);
-      // The final log's "samples" is the filtered count.
-      {
-        std::string text = ReadText(LogPath(out, view.Stem()));
-        static const std::regex re("\"samples\": [0-9]+");
-        text =
-            std::regex_replace(text, re, Msg("\"samples\": ", job.stats.kept),
-                               std::regex_constants::format_first_only);
-        WriteFileAtomically(LogPath(out, view.Stem()),
-                            [&](std::ostream& os) { os << text; });
-      }
       ++r.filtered;
       r.samples += job.stats.samples;
       r.kept += job.stats.kept;

@@ -354,4 +354,15 @@ std::string CloudMetrics::ToString() const {
   return s;
 }
 
+bool AgreesWithDepthMap(const Eigen::Vector3d& X, const DepthMap& map,
+                        double rel_tolerance) {
+  Eigen::Vector2d px;
+  if (!map.camera.Project(X, &px) || !map.camera.InImage(px)) return false;
+  const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
+  if (x < 0 || y < 0 || x >= map.width() || y >= map.height()) return false;
+  const float d = map.depth.at<float>(y, x);
+  const double z = map.camera.Depth(X);
+  return d > 0 && std::abs(d - z) <= rel_tolerance * z;
+}
+
 }  // namespace wild_mvs

@@ -16,6 +16,7 @@
 
 #include "test_paths.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/core/metrics.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/core/thread_pool.h"
@@ -50,17 +51,8 @@ Counts Evaluate(const std::vector<DepthMap>& maps, size_t mi) {
         inside = inside && X[k] >= kBox[k] - kMargin &&
                  X[k] <= kBox[k + 3] + kMargin;
       bool agree = false;
-      for (size_t oj = 0; oj < maps.size() && !agree; ++oj) {
-        if (oj == mi) continue;
-        const DepthMap& o = maps[oj];
-        Eigen::Vector2d px;
-        if (!o.camera.Project(X, &px) || !o.camera.InImage(px)) continue;
-        const int ox = static_cast<int>(px.x()), oy = static_cast<int>(px.y());
-        if (ox < 0 || oy < 0 || ox >= o.width() || oy >= o.height()) continue;
-        const float od = o.depth.at<float>(oy, ox);
-        const double z = o.camera.Depth(X);
-        agree = od > 0 && std::abs(od - z) <= kConsistency * z;
-      }
+      for (size_t oj = 0; oj < maps.size() && !agree; ++oj)
+        agree = oj != mi && AgreesWithDepthMap(X, maps[oj], kConsistency);
       if (inside) ++c.in_box;
       if (agree) ++c.consistent;
       if (inside && agree) ++c.correct;

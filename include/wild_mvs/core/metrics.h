@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "wild_mvs/core/camera.h"
+#include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/point_cloud.h"
 
 namespace wild_mvs {
@@ -77,6 +78,13 @@ DepthMetrics EvaluateDepth(const cv::Mat& depth, const cv::Mat& gt,
 DepthMetrics EvaluateDepth(const cv::Mat& depth, const Camera& camera,
                            const cv::Mat& gt, const Camera& gt_camera,
                            const DepthMetricsOptions& options = {});
+
+// The multi-view agreement of the "correct sample" rule (bench/run_bench.sh,
+// the real-image MVS test): world point X projects inside `map`, which
+// holds a depth there (pixel containing the projection) within
+// rel_tolerance * z of X's depth z in that view.
+bool AgreesWithDepthMap(const Eigen::Vector3d& X, const DepthMap& map,
+                        double rel_tolerance);
 
 // Resamples the depth map `depth` of camera `from` to camera `to` of the same
 // pose (throws Error when the poses differ by more than 1e-6): each pixel
