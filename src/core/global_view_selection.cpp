@@ -165,99 +165,139 @@ GlobalViewSelection SelectGlobalViews(
   const Camera& cr = scene.views[ref].camera;
   const int nv = static_cast<int>(scene.views.size());
 
-  // R's features: for each, the views seeing it and their unit lines of
-  // sight.
+  // R's features, flattened: feature f's observing views (deduplicated, in
+  // track order) and their unit lines of sight are obs_view / obs_dir
+  // [f.begin, f.begin + f.count). Everything below touches only R's
+  // features and the views that see them, so the cost of a call does not
+  // grow with the collection (for a given track length).
   struct Feature {
     Eigen::Vector3d X;
-    std::vector<std::pair<int, Eigen::Vector3d>> seen;  // view, direction
+    int begin = 0, count = 0;
     double within = 1;  // product of w_a over pairs inside N
     double s_ref = 0;
+    // Members of N that see the feature, in the order they entered N, as
+    // slots; pw[k * count + s] = ParallaxWeight(dir of member k, dir of s).
+    std::vector<int> members;
+    std::vector<double> pw;
   };
   std::vector<Feature> feats;
-  std::vector<std::vector<int>> cand_feats(nv);
+  std::vector<int> obs_view;
+  std::vector<Eigen::Vector3d> obs_dir;
   const std::vector<int> empty;
   const std::vector<int>& mine = ref < static_cast<int>(points_per_view.size())
                                      ? points_per_view[ref]
                                      : empty;
+  feats.reserve(mine.size());
   for (int p : mine) {
     const SparsePoint& sp = scene.points[p];
     if (cr.Depth(sp.xyz) <= 0) continue;
     Feature f;
     f.X = sp.xyz;
     f.s_ref = FeatureScale(cr, sp.xyz);
+    f.begin = static_cast<int>(obs_view.size());
     for (const Observation& o : sp.track) {
       if (o.view < 0 || o.view >= nv) continue;
       bool dup = false;
-      for (const auto& s : f.seen) dup |= s.first == o.view;
+      for (int k = f.begin; k < static_cast<int>(obs_view.size()); ++k)
+        dup |= obs_view[k] == o.view;
       if (dup) continue;
       const Camera& c = scene.views[o.view].camera;
       if (c.Depth(sp.xyz) <= 0) continue;
-      f.seen.emplace_back(o.view, (sp.xyz - c.Center()).normalized());
+      obs_view.push_back(o.view);
+      obs_dir.push_back((sp.xyz - c.Center()).normalized());
     }
-    const int fi = static_cast<int>(feats.size());
-    for (const auto& s : f.seen)
-      if (s.first != ref) cand_feats[s.first].push_back(fi);
+    f.count = static_cast<int>(obs_view.size()) - f.begin;
     feats.push_back(std::move(f));
   }
-  auto direction = [&](const Feature& f, int view) -> const Eigen::Vector3d* {
-    for (const auto& s : f.seen)
-      if (s.first == view) return &s.second;
-    return nullptr;
+  // Enters the view of slot s into f's members: its parallax weights with
+  // every view of f (computed once, used by every later score).
+  auto add_member = [&](Feature* f, int s) {
+    const Eigen::Vector3d& dm = obs_dir[f->begin + s];
+    f->members.push_back(s);
+    for (int k = 0; k < f->count; ++k)
+      f->pw.push_back(ParallaxWeight(dm, obs_dir[f->begin + k], amax));
   };
 
-  // Candidates: share features and have parallax with R.
-  std::vector<int> candidates;
-  for (int v = 0; v < nv; ++v) {
-    if (v == ref || cand_feats[v].empty()) continue;
-    std::vector<double> angles;
-    for (int fi : cand_feats[v]) {
-      const Eigen::Vector3d* dr = direction(feats[fi], ref);
-      const Eigen::Vector3d* dv = direction(feats[fi], v);
-      if (!dr || !dv) continue;
-      angles.push_back(std::acos(std::clamp(dr->dot(*dv), -1.0, 1.0)));
+  // The other views seeing R's features, ascending, each with its features
+  // (ascending) as (feature, slot, resolution weight w_s).
+  struct Entry {
+    int view, feature, slot;
+    double ws;
+  };
+  std::vector<Entry> entries;
+  entries.reserve(obs_view.size());
+  std::vector<int> ref_slot(feats.size(), -1);
+  for (size_t fi = 0; fi < feats.size(); ++fi) {
+    Feature& f = feats[fi];
+    for (int s = 0; s < f.count; ++s) {
+      const int v = obs_view[f.begin + s];
+      if (v == ref) {
+        ref_slot[fi] = s;
+        continue;
+      }
+      const double r = f.s_ref / FeatureScale(scene.views[v].camera, f.X);
+      entries.push_back({v, static_cast<int>(fi), s, ResolutionWeight(r)});
     }
-    if (Median(angles) < options.min_baseline_deg * kDeg) continue;
-    candidates.push_back(v);
   }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.view != b.view ? a.view < b.view : a.feature < b.feature;
+  });
+  // Candidates: share features and have parallax with R.
+  struct Candidate {
+    int view;
+    size_t begin, end;  // into entries
+    bool taken = false;
+  };
+  std::vector<Candidate> candidates;
+  std::vector<double> angles;
+  for (size_t e0 = 0; e0 < entries.size();) {
+    size_t e1 = e0;
+    while (e1 < entries.size() && entries[e1].view == entries[e0].view) ++e1;
+    angles.clear();
+    for (size_t e = e0; e < e1; ++e) {
+      const Feature& f = feats[entries[e].feature];
+      const int rs = ref_slot[entries[e].feature];
+      if (rs < 0) continue;
+      const Eigen::Vector3d& dr = obs_dir[f.begin + rs];
+      const Eigen::Vector3d& dv = obs_dir[f.begin + entries[e].slot];
+      angles.push_back(std::acos(std::clamp(dr.dot(dv), -1.0, 1.0)));
+    }
+    if (!(Median(angles) < options.min_baseline_deg * kDeg))
+      candidates.push_back({entries[e0].view, e0, e1});
+    e0 = e1;
+  }
+  for (size_t fi = 0; fi < feats.size(); ++fi)
+    if (ref_slot[fi] >= 0) add_member(&feats[fi], ref_slot[fi]);
 
   GlobalViewSelection out;
-  std::vector<int> in_n{ref};
-  std::vector<uint8_t> taken(nv, 0);
   while (static_cast<int>(out.neighbors.size()) < options.num_neighbors) {
     double best = 0;
-    int best_v = -1;
-    for (int v : candidates) {
-      if (taken[v]) continue;
+    Candidate* chosen = nullptr;
+    for (Candidate& c : candidates) {
+      if (c.taken) continue;
       double score = 0;
-      for (int fi : cand_feats[v]) {
-        const Feature& f = feats[fi];
-        const Eigen::Vector3d* dv = direction(f, v);
+      for (size_t e = c.begin; e < c.end; ++e) {
+        const Feature& f = feats[entries[e].feature];
         double w = f.within;
-        for (int vi : in_n) {
-          const Eigen::Vector3d* di = direction(f, vi);
-          if (di) w *= ParallaxWeight(*di, *dv, amax);
-        }
-        const double r = f.s_ref / FeatureScale(scene.views[v].camera, f.X);
-        score += w * ResolutionWeight(r);
+        for (size_t k = 0; k < f.members.size(); ++k)
+          w *= f.pw[k * f.count + entries[e].slot];
+        score += w * entries[e].ws;
       }
       if (score > best) {
         best = score;
-        best_v = v;
+        chosen = &c;
       }
     }
-    if (best_v < 0) break;
+    if (!chosen) break;
     // Update the within-N products of the features the new view sees.
-    for (int fi : cand_feats[best_v]) {
-      Feature& f = feats[fi];
-      const Eigen::Vector3d* dv = direction(f, best_v);
-      for (int vi : in_n) {
-        const Eigen::Vector3d* di = direction(f, vi);
-        if (di) f.within *= ParallaxWeight(*di, *dv, amax);
-      }
+    for (size_t e = chosen->begin; e < chosen->end; ++e) {
+      Feature& f = feats[entries[e].feature];
+      for (size_t k = 0; k < f.members.size(); ++k)
+        f.within *= f.pw[k * f.count + entries[e].slot];
+      add_member(&f, entries[e].slot);
     }
-    taken[best_v] = 1;
-    in_n.push_back(best_v);
-    out.neighbors.push_back(best_v);
+    chosen->taken = true;
+    out.neighbors.push_back(chosen->view);
     out.scores.push_back(best);
   }
 
