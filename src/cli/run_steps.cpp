@@ -162,6 +162,8 @@ DepthStageResult RunDepthStage(const Scene& scene,
                     StderrIsTerminal());
   const int total = static_cast<int>(views.size());
   std::vector<int> to_filter;
+  // Once for the run, not per view (it grows with the collection).
+  const std::vector<std::vector<int>> points_per_view = scene.PointsPerView();
   for (int k = 0; k < total; ++k) {
     const int v = views[k];
     const View& view = scene.views[v];
@@ -186,7 +188,8 @@ DepthStageResult RunDepthStage(const Scene& scene,
     ViewReport report;
     try {
       const cv::Mat mask = LoadViewMask(view);
-      map = ReconstructView(scene, v, images, config.mvs, pool, &report, mask);
+      map = ReconstructView(scene, v, images, config.mvs, pool, &report, mask,
+                            &points_per_view);
     } catch (const Error& e) {
       r.failures.push_back(Msg(view.name, ": ", e.what()));
       progress.End(Msg(prefix, ": FAILED: ", e.what()));

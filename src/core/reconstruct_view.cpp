@@ -80,7 +80,8 @@ OwnedImage MakeMatchImage(std::shared_ptr<const cv::Mat> img, bool color) {
 
 DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
                          const MvsOptions& options, ThreadPool* pool,
-                         ViewReport* report, const cv::Mat& mask) {
+                         ViewReport* report, const cv::Mat& mask,
+                         const std::vector<std::vector<int>>* points_per_view) {
   const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = ThreadCpuSeconds();
   double body_cpu = 0;
@@ -96,7 +97,13 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
       "ReconstructView: mask of view '", scene.views[ref].name,
       "' must be CV_8U ", cam_full.width, "x", cam_full.height);
   ViewReport rep;
-  const std::vector<std::vector<int>> ppv = scene.PointsPerView();
+  std::vector<std::vector<int>> own_ppv;
+  if (!points_per_view) own_ppv = scene.PointsPerView();
+  const std::vector<std::vector<int>>& ppv =
+      points_per_view ? *points_per_view : own_ppv;
+  Require(ppv.size() == scene.views.size(),
+          "ReconstructView: points_per_view has ", ppv.size(), " entries for ",
+          scene.views.size(), " views");
 
   // 1. Global view selection.
   GlobalViewSelection sel = SelectGlobalViews(scene, ref, ppv, options.global);

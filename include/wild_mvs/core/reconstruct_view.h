@@ -66,8 +66,12 @@ struct ViewReport {
 // not be the pool this call runs on (ThreadPool::ParallelFor). mask: CV_8U of
 // the reference image's size, 0 = ignore (empty = none). Deterministic: the
 // same output whatever the number of threads. Throws Error on bad input.
-DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
-                         const MvsOptions& options, ThreadPool* pool,
-                         ViewReport* report, const cv::Mat& mask = cv::Mat());
+// points_per_view: scene.PointsPerView() when the caller reconstructs many
+// views of one scene (computed once: it costs O(points x track length), i.e.
+// grows with the collection); null = computed here.
+DepthMap ReconstructView(
+    const Scene& scene, int ref, ImageCache& images, const MvsOptions& options,
+    ThreadPool* pool, ViewReport* report, const cv::Mat& mask = cv::Mat(),
+    const std::vector<std::vector<int>>* points_per_view = nullptr);
 
 }  // namespace wild_mvs
