@@ -28,51 +28,17 @@
 #include <random>
 #include <string>
 
+#include "courtyard.h"
 #include "synthetic_scene.h"
 #include "wild_mvs/core/error.h"
 
 using namespace wild_mvs;
+using courtyard::Box;
+using courtyard::Sphere;
 using testing::SyntheticObject;
 using testing::SyntheticSpec;
-using T = SyntheticObject::Type;
 
 namespace {
-
-SyntheticObject Plane(Eigen::Vector3d c, Eigen::Vector3d u, Eigen::Vector3d v,
-                      double hu, double hv, int seed, double tex) {
-  SyntheticObject o;
-  o.type = T::kPlane;
-  o.center = c;
-  o.axis_u = u;
-  o.axis_v = v;
-  o.size = Eigen::Vector3d(hu, hv, 1);
-  o.texture_seed = seed;
-  o.texture_scale = tex;
-  return o;
-}
-
-SyntheticObject Box(Eigen::Vector3d c, Eigen::Vector3d half, double yaw_deg,
-                    int seed, double tex) {
-  SyntheticObject o;
-  o.type = T::kBox;
-  o.center = c;
-  o.size = half;
-  o.rotation = Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ())
-                   .toRotationMatrix();
-  o.texture_seed = seed;
-  o.texture_scale = tex;
-  return o;
-}
-
-SyntheticObject Sphere(Eigen::Vector3d c, double r, int seed, double tex) {
-  SyntheticObject o;
-  o.type = T::kSphere;
-  o.center = c;
-  o.size = Eigen::Vector3d(r, r, r);
-  o.texture_seed = seed;
-  o.texture_scale = tex;
-  return o;
-}
 
 SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
                         unsigned seed, int points) {
@@ -85,17 +51,9 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
   s.num_sparse_points = points;
   s.sparse_pixel_noise = 0.3;
   s.supersample = 2;
-  const Eigen::Vector3d X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
-  s.objects.push_back(Plane({0, 0, 0}, X, Y, 3.0, 3.0, 11, 0.06));  // ground
-  s.objects.push_back(
-      Plane({0, 1.6, 0.9}, X, Z, 2.4, 0.9, 12, 0.08));  // back wall
-  s.objects.push_back(
-      Box({0.55, 0.35, 0.25}, {0.28, 0.22, 0.25}, 30, 21, 0.05));
-  s.objects.push_back(Box({-0.6, -0.2, 0.2}, {0.2, 0.3, 0.2}, -20, 31, 0.05));
-  s.objects.push_back(Box({-0.2, 0.9, 0.5}, {0.12, 0.12, 0.5}, 10, 32, 0.04));
-  s.objects.push_back(Sphere({-0.1, 0.5, 0.3}, 0.3, 41, 0.05));
-  s.objects.push_back(Sphere({0.9, -0.4, 0.15}, 0.15, 42, 0.04));
-  s.look_at = Eigen::Vector3d(0, 0.3, 0.35);
+  const Eigen::Vector3d Z(0, 0, 1);
+  s.objects = courtyard::Objects();
+  s.look_at = courtyard::LookAt();
 
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> U(0, 1);
