@@ -9,16 +9,18 @@
 #   bench/run_scale.sh [--sizes 100,250,500] [--max-image-size 320]
 #                      [--threads 2] [--work /tmp/wild_mvs_scale]
 #                      [--image-cache-mb 64] [--map-cache-mb 64]
-#                      [--pending-mb 32] [--no-results] [-- EXTRA_FLAGS...]
+#                      [--pending-mb 32] [--no-results] [--table-only]
+#                      [-- EXTRA_FLAGS...]
 #
 # Collections are rendered into WORK (never into the repository) once and
-# reused: the largest first; the smaller ones hard-link its first N images
-# (view i of a collection depends only on the seed and i) and get their own
-# model. Every run starts from an empty output folder. Prints a table
+# reused: the largest first; the smaller ones hard-link the first N images of
+# a larger one (view i of a collection depends only on the seed and i) and
+# get their own model. Every run starts from an empty output folder. Prints a table
 # (views, CPU-s, CPU-s per view, peak RSS MB, samples, points) and writes it
 # to bench/results/scale.tsv with the raw outputs (time -v, summary.json,
 # the log's summary lines) under bench/results/scale/ (--no-results: stdout
-# only). BUILD_DIR (default build/) holds bin/wild_mvs and bin/make_collection.
+# only). --table-only: no rendering or runs, the table of the runs already in
+# WORK (e.g. one size per invocation, then all sizes). BUILD_DIR (default build/) holds bin/wild_mvs and bin/make_collection.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
@@ -31,6 +33,7 @@ IMAGE_CACHE_MB=64
 MAP_CACHE_MB=64
 PENDING_MB=32
 RESULTS=1
+TABLE_ONLY=0
 EXTRA=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -42,6 +45,7 @@ while [ $# -gt 0 ]; do
     --map-cache-mb) MAP_CACHE_MB="$2"; shift 2 ;;
     --pending-mb) PENDING_MB="$2"; shift 2 ;;
     --no-results) RESULTS=0; shift ;;
+    --table-only) TABLE_ONLY=1; shift ;;
     --) shift; EXTRA=("$@"); break ;;
     *) echo "run_scale.sh: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -55,25 +59,34 @@ IFS=, read -r -a sizes <<<"$SIZES"
 largest=0
 for n in "${sizes[@]}"; do [ "$n" -gt "$largest" ] && largest=$n; done
 
-# Collections: the largest rendered, the others linked from it.
+# Collections: the largest rendered, the others link the images of a larger
+# collection in WORK (those that exist; make_collection renders the rest).
 render() {  # N
-  local n=$1 dir="$WORK/c$1"
-  if [ "$n" -ne "$largest" ]; then
+  local n=$1 dir="$WORK/c$1" src="" d m f i
+  for d in "$WORK"/c*/images; do
+    m=${d%/images}
+    m=${m##*/c}
+    [[ $m =~ ^[0-9]+$ ]] && [ "$m" -gt "$n" ] && src="$WORK/c$m/images"
+  done
+  if [ -n "$src" ]; then
     mkdir -p "$dir/images"
     for ((i = 0; i < n; i++)); do
       f=$(printf 'img_%04d.jpg' "$i")
-      [ -e "$dir/images/$f" ] || ln "$WORK/c$largest/images/$f" "$dir/images/$f"
+      [ -e "$dir/images/$f" ] || [ ! -e "$src/$f" ] || ln "$src/$f" "$dir/images/$f"
     done
   fi
   "$BIN/make_collection" "$dir" --views "$n" --seed 1 >&2
 }
-render "$largest"
-for n in "${sizes[@]}"; do [ "$n" -ne "$largest" ] && render "$n"; done
+if [ "$TABLE_ONLY" = 0 ]; then
+  render "$largest"
+  for n in "${sizes[@]}"; do [ "$n" -ne "$largest" ] && render "$n"; done
+fi
 
 TSV="views	cpu_s	cpu_s_per_view	wall_s	peak_rss_mb	samples	fused_points	samples_per_view"
 rows=()
 for n in "${sizes[@]}"; do
   out="$WORK/out$n"
+  if [ "$TABLE_ONLY" = 0 ]; then
   rm -rf "$out"
   echo "run_scale: reconstructing $n views at --max-image-size $MAX_IMAGE..." >&2
   /usr/bin/time -v -o "$WORK/time$n.txt" "$BIN/wild_mvs" reconstruct "$WORK/c$n" "$out" \
@@ -81,6 +94,9 @@ for n in "${sizes[@]}"; do
     --image.cache_mb "$IMAGE_CACHE_MB" --fusion.map_cache_mb "$MAP_CACHE_MB" \
     --fusion.pending_mb "$PENDING_MB" "${EXTRA[@]}" >"$WORK/log$n.txt" 2>&1 \
     || { tail -20 "$WORK/log$n.txt" >&2; echo "run_scale.sh: run of $n views failed" >&2; exit 1; }
+  fi
+  [ -f "$WORK/time$n.txt" ] && [ -f "$out/summary.json" ] ||
+    { echo "run_scale.sh: no finished run of $n views in $WORK" >&2; exit 1; }
   user=$(awk -F': ' '/User time/ {print $2}' "$WORK/time$n.txt")
   sys=$(awk -F': ' '/System time/ {print $2}' "$WORK/time$n.txt")
   rss=$(awk -F': ' '/Maximum resident/ {print $2}' "$WORK/time$n.txt")

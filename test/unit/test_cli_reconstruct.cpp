@@ -2,15 +2,22 @@
 // (the built binary) on a small rendered dataset with exact ground truth:
 // valid and accurate files, resumability, --force, thread-count
 // independence, atomic outputs, clear errors for bad output folders, views
-// and masks.
+// and masks, and a run killed with SIGKILL and resumed.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "synthetic_scene.h"
 #include "test_paths.h"
@@ -375,6 +382,132 @@ TEST_F(CliReconstruct, MaskExcludesPixels) {
   EXPECT_EQ(cv::countNonZero(d.depth.colRange(0, half)), 0);
   EXPECT_GT(cv::countNonZero(d.depth.colRange(half, d.width())),
             d.height() * half / 3);
+}
+
+// The files of OUT (relative paths) that are results: every regular file but
+// the atomic writer's temporary files (".NAME.tmp...") and the run's own
+// timing records (summary.json).
+std::vector<std::string> ResultFiles(const std::string& dir) {
+  std::vector<std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    const std::string name = e.path().filename().string();
+    if (name.find(".tmp") != std::string::npos || name == "summary.json")
+      continue;
+    files.push_back(fs::relative(e.path(), dir).string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+int CountFiles(const std::string& dir, const std::string& ext) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return 0;
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    n += e.is_regular_file() && name[0] != '.' && name.size() > ext.size() &&
+         name.compare(name.size() - ext.size(), ext.size(), ext) == 0;
+  }
+  return n;
+}
+
+TEST(CliReconstructKill, ResumesAfterSigkillWithTheUninterruptedResult) {
+  // 8 views of a textured plane; a run killed (SIGKILL: no clean-up) once
+  // at least one view is done, then run again, ends with the same files and
+  // the same bytes as a run that was never interrupted.
+  testing::SyntheticSpec spec = testing::SlantedPlaneSpec(25, 8);
+  spec.width = 128;
+  spec.height = 96;
+  spec.focal = 120;
+  spec.num_sparse_points = 300;
+  const testing::SyntheticScene scene = testing::Render(spec);
+  const std::string root = testing::MakeTempDir("wild_mvs_cli_kill");
+  const std::string dataset = root + "/dataset";
+  testing::WriteDataset(scene, dataset);
+  const std::string args = " --threads 2 --stages depth,fuse";
+  const std::string whole = root + "/whole", killed = root + "/killed";
+  const RunResult ref =
+      RunCli("reconstruct '" + dataset + "' '" + whole + "'" + args);
+  ASSERT_EQ(ref.status, 0) << ref.output;
+
+  // Started directly (fork + exec) so that its pid is known.
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string log = root + "/killed.log";
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, 1);
+      dup2(fd, 2);
+    }
+    execl(WILD_MVS_CLI, WILD_MVS_CLI, "reconstruct", dataset.c_str(),
+          killed.c_str(), "--threads", "2", "--stages", "depth,fuse",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Killed as soon as a view's log exists (raw maps first: the consistency
+  // filter is on), i.e. in the middle of the depth stage.
+  bool done_one = false, exited = false;
+  int status = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!done_one &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(300)) {
+    done_one = CountFiles(killed + "/raw/log", ".json") +
+                   CountFiles(killed + "/log", ".json") >=
+               1;
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      exited = true;
+      break;
+    }
+    if (!done_one) usleep(2000);  // polling the condition
+  }
+  if (!exited) {
+    kill(pid, SIGKILL);
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  }
+  ASSERT_TRUE(done_one) << "no view finished within 300 s";
+  ASSERT_FALSE(exited && WIFEXITED(status))
+      << "the run ended before it could be killed; "
+         "the test needs a longer run";
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  const int raw_done = CountFiles(killed + "/raw/log", ".json");
+  EXPECT_LT(raw_done, 8) << "killed after the depth stage: not a mid-run kill";
+  EXPECT_FALSE(fs::exists(killed + "/fused.ply"));
+  std::printf("killed after %d of 8 views, %d temporary files left\n", raw_done,
+              CountTempFiles(killed));
+
+  // The rerun resumes the finished views and completes the rest.
+  const RunResult again =
+      RunCli("reconstruct '" + dataset + "' '" + killed + "'" + args);
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_GE(Count(again.output, "matched earlier, to be filtered"), raw_done)
+      << again.output;
+  EXPECT_NE(again.output.find("summary: 8 views"), std::string::npos);
+
+  // Same set of results, byte for byte (depth, normal, confidence maps,
+  // cameras, previews, logs but their timings, the fused cloud); temporary
+  // files a kill leaves behind are never taken as results.
+  const std::vector<std::string> want = ResultFiles(whole);
+  ASSERT_EQ(ResultFiles(killed), want);
+  int compared_maps = 0;
+  for (const std::string& f : want) {
+    if (f.rfind("log/", 0) == 0 || f.rfind("raw/log/", 0) == 0 ||
+        f == "run.yaml")
+      continue;  // timings and the dataset path differ
+    EXPECT_EQ(ReadFile(killed + "/" + f), ReadFile(whole + "/" + f)) << f;
+    compared_maps += f.rfind("depth/", 0) == 0;
+  }
+  EXPECT_EQ(compared_maps, 8);
+  for (const View& v : scene.scene.views) {
+    const std::string log = ReadFile(killed + "/log/" + v.Stem() + ".json");
+    const DepthMap m = ReadDepthMapFiles(killed, v.Stem()).map;
+    EXPECT_NE(log.find("\"samples\": " + std::to_string(m.CountValid())),
+              std::string::npos)
+        << v.Stem();
+  }
+  std::error_code ec;
+  fs::remove_all(root, ec);
 }
 
 }  // namespace
