@@ -390,11 +390,11 @@ std::vector<int> StreamingFusion::RelatedViews(int view,
   };
   if (!map.neighbors.empty()) {
     for (int u : map.neighbors) add(u);
-    for (const Added& a : added_) {
-      if (std::find(a.neighbors.begin(), a.neighbors.end(), view) !=
-          a.neighbors.end())
-        add(a.view);
-    }
+    // The views that list v, in the order they were added (an index: no
+    // scan of every added view).
+    auto listing = listed_by_.find(view);
+    if (listing != listed_by_.end())
+      for (int u : listing->second) add(u);
     if (static_cast<int>(related.size()) > options_.max_neighbors)
       related.resize(options_.max_neighbors);
   } else {
@@ -679,6 +679,10 @@ void StreamingFusion::AddView(int view) {
 
   added_index_[view] = added_.size();
   added_.push_back({view, V.camera, V.neighbors});
+  for (int u : V.neighbors) {
+    std::vector<int>& l = listed_by_[u];
+    if (l.empty() || l.back() != view) l.push_back(view);
+  }
   ++stats_.views;
   UpdatePeak();  // pending counted before trimming: it was held
   TrimPending();

@@ -194,6 +194,8 @@ class StreamingFusion {
   };
   std::vector<Added> added_;
   std::unordered_map<int, size_t> added_index_;
+  // u -> the added views whose neighbours include u, in added order.
+  std::unordered_map<int, std::vector<int>> listed_by_;
 
   // LRU of prepared maps.
   std::list<std::pair<int, std::shared_ptr<const Prepared>>> lru_;
