@@ -6,7 +6,7 @@
 # with /usr/bin/time -v. The goal: CPU time per view and peak RSS flat from
 # the smallest to the largest collection (docs/SCALE.md).
 #
-#   bench/run_scale.sh [--sizes 100,250,500] [--max-image-size 320]
+#   bench/run_scale.sh [--sizes 100,250,500] [--max-image-size 240]
 #                      [--threads 2] [--work /tmp/wild_mvs_scale]
 #                      [--image-cache-mb 64] [--map-cache-mb 64]
 #                      [--pending-mb 32] [--no-results] [--table-only]
@@ -15,8 +15,9 @@
 # Collections are rendered into WORK (never into the repository) once and
 # reused: the largest first; the smaller ones hard-link the first N images of
 # a larger one (view i of a collection depends only on the seed and i) and
-# get their own model. Every run starts from an empty output folder. Prints a table
-# (views, CPU-s, CPU-s per view, peak RSS MB, samples, points) and writes it
+# get their own model. Every run starts from an empty output folder. Prints a
+# table (views, CPU-s, CPU-s per view, of it ReconstructView's per view,
+# wall-s, peak RSS MB, samples, fused points, samples per view) and writes it
 # to bench/results/scale.tsv with the raw outputs (time -v, summary.json,
 # the log's summary lines) under bench/results/scale/ (--no-results: stdout
 # only). --table-only: no rendering or runs, the table of the runs already in
@@ -26,7 +27,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
 BIN="$BUILD_DIR/bin"
 SIZES=100,250,500
-MAX_IMAGE=320
+MAX_IMAGE=240
 THREADS=2
 WORK=/tmp/wild_mvs_scale
 IMAGE_CACHE_MB=64
@@ -82,18 +83,18 @@ if [ "$TABLE_ONLY" = 0 ]; then
   for n in "${sizes[@]}"; do [ "$n" -ne "$largest" ] && render "$n"; done
 fi
 
-TSV="views	cpu_s	cpu_s_per_view	wall_s	peak_rss_mb	samples	fused_points	samples_per_view"
+TSV="views	cpu_s	cpu_s_per_view	mvs_cpu_s_per_view	wall_s	peak_rss_mb	samples	fused_points	samples_per_view"
 rows=()
 for n in "${sizes[@]}"; do
   out="$WORK/out$n"
   if [ "$TABLE_ONLY" = 0 ]; then
-  rm -rf "$out"
-  echo "run_scale: reconstructing $n views at --max-image-size $MAX_IMAGE..." >&2
-  /usr/bin/time -v -o "$WORK/time$n.txt" "$BIN/wild_mvs" reconstruct "$WORK/c$n" "$out" \
-    --max-image-size "$MAX_IMAGE" --stages depth,fuse --threads "$THREADS" \
-    --image.cache_mb "$IMAGE_CACHE_MB" --fusion.map_cache_mb "$MAP_CACHE_MB" \
-    --fusion.pending_mb "$PENDING_MB" "${EXTRA[@]}" >"$WORK/log$n.txt" 2>&1 \
-    || { tail -20 "$WORK/log$n.txt" >&2; echo "run_scale.sh: run of $n views failed" >&2; exit 1; }
+    rm -rf "$out"
+    echo "run_scale: reconstructing $n views at --max-image-size $MAX_IMAGE..." >&2
+    /usr/bin/time -v -o "$WORK/time$n.txt" "$BIN/wild_mvs" reconstruct "$WORK/c$n" "$out" \
+      --max-image-size "$MAX_IMAGE" --stages depth,fuse --threads "$THREADS" \
+      --image.cache_mb "$IMAGE_CACHE_MB" --fusion.map_cache_mb "$MAP_CACHE_MB" \
+      --fusion.pending_mb "$PENDING_MB" "${EXTRA[@]}" >"$WORK/log$n.txt" 2>&1 \
+      || { tail -20 "$WORK/log$n.txt" >&2; echo "run_scale.sh: run of $n views failed" >&2; exit 1; }
   fi
   [ -f "$WORK/time$n.txt" ] && [ -f "$out/summary.json" ] ||
     { echo "run_scale.sh: no finished run of $n views in $WORK" >&2; exit 1; }
@@ -104,10 +105,15 @@ for n in "${sizes[@]}"; do
     awk -F: '{s = 0; for (i = 1; i <= NF; i++) s = s * 60 + $i; print s}')
   samples=$(sed -n 's/.*"valid_samples": \([0-9]*\).*/\1/p' "$out/summary.json")
   points=$(sed -n 's/.*"fused_points": \([0-9]*\).*/\1/p' "$out/summary.json")
+  # CPU of ReconstructView per view (the views' logs; raw/ when filtered).
+  logs="$out/raw/log"
+  [ -d "$logs" ] || logs="$out/log"
+  mvs=$(cat "$logs"/*.json | sed -n 's/.*"cpu_seconds": \([0-9.e+-]*\).*/\1/p' |
+    awk '{s += $1} END {print s + 0}')
   rows+=("$(awk -v n="$n" -v u="$user" -v s="$sys" -v w="$wall" -v r="$rss" \
-    -v sm="$samples" -v p="$points" 'BEGIN {
-      printf "%d\t%.1f\t%.3f\t%.1f\t%.0f\t%d\t%d\t%.0f", n, u + s, (u + s) / n,
-             w, r / 1024, sm, p, sm / n }')")
+    -v sm="$samples" -v p="$points" -v m="$mvs" 'BEGIN {
+      printf "%d\t%.1f\t%.3f\t%.3f\t%.1f\t%.0f\t%d\t%d\t%.0f", n, u + s,
+             (u + s) / n, m / n, w, r / 1024, sm, p, sm / n }')")
 done
 
 {
