@@ -222,9 +222,11 @@ DepthStageResult RunDepthStage(const Scene& scene,
     progress.End(note);
   }
   progress.Finish();
+  ReleaseFreeMemory();  // the stages' peaks do not add up
   if (filter && !to_filter.empty()) {
     FilterStageResult f =
         FilterDepthMaps(scene, to_filter, gc, raw, out, pool, log);
+    ReleaseFreeMemory();
     r.computed += f.filtered;
     r.samples += f.kept;
     r.consistency_samples += f.samples;

@@ -3,6 +3,10 @@
 
 #include <sys/resource.h>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 namespace wild_mvs {
 
 double CpuSeconds() {
@@ -10,6 +14,12 @@ double CpuSeconds() {
   if (getrusage(RUSAGE_SELF, &u) != 0) return 0;
   return u.ru_utime.tv_sec + u.ru_stime.tv_sec +
          1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+void ReleaseFreeMemory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
 }
 
 double PeakRssMb() {

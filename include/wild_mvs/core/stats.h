@@ -24,4 +24,10 @@ double CpuSeconds();
 // Peak resident set size of the process in MB; 0 when unknown.
 double PeakRssMb();
 
+// Returns the allocator's free memory to the system (glibc: malloc_trim,
+// every arena). Between stages: memory a stage's worker threads freed stays
+// in their arenas otherwise, where the next stage's (main-thread)
+// allocations cannot reuse it, and adds to the peak. No-op elsewhere.
+void ReleaseFreeMemory();
+
 }  // namespace wild_mvs
