@@ -371,10 +371,11 @@ void WriteSummary(const std::string& path, size_t views, const StageResults& r,
   if (r.depth_ran) {
     sum << " (" << r.depth.computed << " computed, " << r.depth.skipped
         << " resumed";
-    if (r.depth.unfiltered > 0) {
-      sum << ", " << r.depth.unfiltered << " matched, to be filtered";
-    }
     sum << "), " << r.depth.samples << " valid depth samples";
+    if (r.depth.unfiltered > 0) {
+      sum << " (before the consistency filter of 'wild_mvs fuse', "
+          << r.depth.unfiltered << " views)";
+    }
   }
   if (r.fused_now) sum << ", " << r.fuse.points << " points";
   if (r.meshed) sum << ", " << r.mesh.faces << " faces";
@@ -451,9 +452,12 @@ int RunReconstruct(const CommandArgs& argv) {
   }
   // Written before the long work so that `fuse OUT` works on partial runs;
   // this also proves that OUT is writable. Shards share it: written once.
+  // A sparse-only run leaves it to the depth runs (the tracks file records
+  // the options it depends on), so its other options need not match theirs.
   if (sharded) {
     WriteOrCheckShardRunRecord(out, args, config, record);
-  } else {
+  } else if (config.run.HasStage("depth") || config.run.HasStage("fuse") ||
+             config.run.HasStage("mesh")) {
     WriteRunRecord(out, record_set);
   }
 

@@ -50,8 +50,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry
       ->Add(OptionRegistry::Join(prefix, "stages"), &o->stages,
             "stages of reconstruct: comma-separated subset of "
-            "sparse,depth,fuse,mesh (depth computes the sparse tracks itself "
-            "when needed; sparse alone: only OUT/sparse, before --shard runs)")
+            "sparse,depth,fuse,mesh (sparse alone: only the sparse tracks, "
+            "before --shard runs)")
       .Note("not empty");
 }
 

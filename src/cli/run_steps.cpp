@@ -180,6 +180,11 @@ DepthStageResult RunDepthStage(const Scene& scene,
     }
     if (filter && !force && ViewOutputsComplete(raw, stem)) {
       to_filter.push_back(v);
+      if (!filter_now) {  // a shard: resumed, its raw samples counted
+        const long long samples = SamplesFromLog(LogPath(raw, stem));
+        if (samples > 0) r.samples += samples;
+        ++r.skipped;
+      }
       progress.Skip(Msg(prefix, ": matched earlier, to be filtered"));
       continue;
     }
@@ -206,7 +211,8 @@ DepthStageResult RunDepthStage(const Scene& scene,
     const int valid = map.CountValid();
     if (filter) {
       to_filter.push_back(v);
-    } else {
+    }
+    if (!filter || !filter_now) {
       r.samples += valid;
       ++r.computed;
     }
@@ -339,15 +345,28 @@ FilterStageResult FilterPendingViews(const Scene& scene,
   if (!options.enabled) return r;
   const std::string raw = out + "/raw";
   std::vector<int> pending;
+  int missing = 0;
   for (size_t i = 0; i < scene.views.size(); ++i) {
     const std::string stem = scene.views[i].Stem();
-    if (ViewOutputsComplete(raw, stem) && !ViewOutputsComplete(out, stem)) {
-      pending.push_back(static_cast<int>(i));
+    const bool done = ViewOutputsComplete(out, stem);
+    if (ViewOutputsComplete(raw, stem)) {
+      if (!done) pending.push_back(static_cast<int>(i));
+    } else if (!done) {
+      ++missing;
     }
   }
   if (pending.empty()) return r;
   log << "consistency: " << pending.size() << " views matched in " << raw
       << " but not yet filtered (e.g. by --shard runs)" << std::endl;
+  if (missing > 0) {
+    // A filtered map is final: one checked before its neighbours' maps
+    // exist is checked against fewer maps than in a single run.
+    log << "consistency: warning: " << missing << " of " << scene.views.size()
+        << " views have no depth map yet; if shards are still running, "
+           "their neighbours are filtered without them (wait for every "
+           "shard before 'wild_mvs fuse')"
+        << std::endl;
+  }
   r = FilterDepthMaps(scene, pending, options, raw, out, pool, log);
   if (!r.failures.empty()) {
     std::string list;

@@ -89,6 +89,33 @@ int CountTempFiles(const std::string& dir) {
   return n;
 }
 
+// Map files (under `subs`) and fused clouds of two OUT folders: the same
+// files, byte for byte, and the same points.
+void ExpectSameResults(const std::string& a_dir, const std::string& b_dir,
+                       const std::vector<std::string>& subs) {
+  for (const std::string& sub : subs) {
+    const std::set<std::string> a = FilesUnder(a_dir, sub),
+                                b = FilesUnder(b_dir, sub);
+    EXPECT_EQ(a, b) << sub;
+    EXPECT_FALSE(a.empty()) << sub;
+    for (const std::string& f : a) {
+      EXPECT_TRUE(ReadFile(a_dir + "/" + f) == ReadFile(b_dir + "/" + f))
+          << f << " differs";
+    }
+  }
+  EXPECT_EQ(FilesUnder(a_dir, "depth").size(), 5u);
+  const PointCloud a = ReadPlyCloud(a_dir + "/fused.ply");
+  const PointCloud b = ReadPlyCloud(b_dir + "/fused.ply");
+  ASSERT_GT(a.size(), 1000u);
+  ASSERT_EQ(a.size(), b.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    differ += (a.xyz[i] != b.xyz[i] || a.normal[i] != b.normal[i]);
+  }
+  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(CountTempFiles(b_dir), 0);
+}
+
 class CliShard : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -127,6 +154,25 @@ class CliShard : public ::testing::Test {
     }
     fuse_run_ =
         RunCli("fuse '" + sharded_ + "' --threads 2", root_ + "/fuse.log");
+
+    // Without the consistency filter: shards write final maps; 2 at once.
+    const std::string nf = common + " --mvs.consistency.enabled false";
+    single_nf_run_ = RunCli("reconstruct '" + dataset_ + "' '" + root_ +
+                                "/single_nf' --threads 2" + nf,
+                            root_ + "/single_nf.log");
+    const std::string sharded_nf = root_ + "/sharded_nf";
+    RunCli("reconstruct '" + dataset_ + "' '" + sharded_nf +
+               "' --threads 1 --stages sparse",
+           root_ + "/sparse_nf.log");
+    const pid_t p1 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_nf +
+                               "' --threads 1 --shard 1/2" + nf,
+                           root_ + "/shard_nf1.log");
+    const pid_t p2 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_nf +
+                               "' --threads 1 --shard 2/2" + nf,
+                           root_ + "/shard_nf2.log");
+    shards_nf_status_ = Wait(p1) == 0 && Wait(p2) == 0;
+    fuse_nf_run_ =
+        RunCli("fuse '" + sharded_nf + "' --threads 2", root_ + "/fuse_nf.log");
   }
   static void TearDownTestSuite() {
     std::error_code ec;
@@ -135,12 +181,16 @@ class CliShard : public ::testing::Test {
   static std::vector<std::string> stems_;
   static std::string root_, dataset_, single_, sharded_;
   static RunResult single_run_, sparse_run_, fuse_run_;
+  static RunResult single_nf_run_, fuse_nf_run_;
+  static bool shards_nf_status_;
   static std::vector<RunResult> shard_runs_;
 };
 std::vector<std::string> CliShard::stems_;
 std::string CliShard::root_, CliShard::dataset_, CliShard::single_,
     CliShard::sharded_;
 RunResult CliShard::single_run_, CliShard::sparse_run_, CliShard::fuse_run_;
+RunResult CliShard::single_nf_run_, CliShard::fuse_nf_run_;
+bool CliShard::shards_nf_status_ = false;
 std::vector<RunResult> CliShard::shard_runs_;
 
 TEST_F(CliShard, ConcurrentShardsThenFuseEqualOneProcess) {
@@ -181,31 +231,25 @@ TEST_F(CliShard, ConcurrentShardsThenFuseEqualOneProcess) {
       << "no sparse points computed: the tracks file is not exercised";
   EXPECT_EQ(tracks, ReadFile(sharded_ + "/sparse/tracks.txt"));
 
-  // Same set of map files, byte for byte (raw and final).
-  for (const char* sub : {"depth", "normal", "confidence", "cameras",
-                          "raw/depth", "raw/normal", "raw/confidence"}) {
-    const std::set<std::string> a = FilesUnder(single_, sub),
-                                b = FilesUnder(sharded_, sub);
-    EXPECT_EQ(a, b) << sub;
-    EXPECT_FALSE(a.empty()) << sub;
-    for (const std::string& f : a) {
-      EXPECT_TRUE(ReadFile(single_ + "/" + f) == ReadFile(sharded_ + "/" + f))
-          << f << " differs";
-    }
-  }
-  EXPECT_EQ(FilesUnder(single_, "depth").size(), 5u);
+  // Same set of map files, byte for byte (raw and final), same cloud.
+  ExpectSameResults(single_, sharded_,
+                    {"depth", "normal", "confidence", "cameras", "raw/depth",
+                     "raw/normal", "raw/confidence"});
+}
 
-  // The same cloud.
-  const PointCloud a = ReadPlyCloud(single_ + "/fused.ply");
-  const PointCloud b = ReadPlyCloud(sharded_ + "/fused.ply");
-  ASSERT_GT(a.size(), 1000u);
-  ASSERT_EQ(a.size(), b.size());
-  size_t differ = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    differ += (a.xyz[i] != b.xyz[i] || a.normal[i] != b.normal[i]);
-  }
-  EXPECT_EQ(differ, 0u);
-  EXPECT_EQ(CountTempFiles(sharded_), 0);
+TEST_F(CliShard, WithoutTheConsistencyFilterShardsWriteFinalMaps) {
+  ASSERT_EQ(single_nf_run_.status, 0) << single_nf_run_.output;
+  ASSERT_TRUE(shards_nf_status_) << ReadFile(root_ + "/shard_nf1.log")
+                                 << ReadFile(root_ + "/shard_nf2.log");
+  ASSERT_EQ(fuse_nf_run_.status, 0) << fuse_nf_run_.output;
+  EXPECT_FALSE(fs::exists(root_ + "/sharded_nf/raw"));
+  EXPECT_EQ(fuse_nf_run_.output.find("filtered"), std::string::npos)
+      << fuse_nf_run_.output;
+  ExpectSameResults(root_ + "/single_nf", root_ + "/sharded_nf",
+                    {"depth", "normal", "confidence", "cameras"});
+  // The filter changes the maps: the comparison above is not vacuous.
+  EXPECT_FALSE(ReadFile(single_ + "/depth/" + stems_[1] + ".pfm") ==
+               ReadFile(root_ + "/single_nf/depth/" + stems_[1] + ".pfm"));
 }
 
 TEST_F(CliShard, ShardWithoutTracksOrWithOtherOptionsFailsClearly) {

@@ -39,7 +39,8 @@ struct DepthStageResult {
   // samples before and kept.
   long long consistency_samples = 0, consistency_kept = 0;
   // Views whose MVS map is in OUT/raw, to be filtered later (filter_now
-  // false: a --shard process; `wild_mvs fuse` filters them).
+  // false: a --shard process; `wild_mvs fuse` filters them). They count in
+  // computed / skipped, and samples are then before the filter.
   int unfiltered = 0;
   double seconds = 0;
   std::vector<std::string> failures;  // "view: problem"
