@@ -258,8 +258,6 @@ struct StageResults {
   bool meshed = false;
 };
 
-// The depth stage (sparse tracks first when the dataset has none and some
-// view is to be computed). Throws when a view failed.
 // The sparse tracks of a dataset without sparse points (scene->points
 // empty): those of an earlier run on OUT when they match
 // (OUT/sparse/tracks.txt), else computed and saved there; a shard never
@@ -289,6 +287,9 @@ void SparseTracks(Scene* scene, const ReconstructConfig& config,
   r->sparse_ran = true;
 }
 
+// The depth stage (sparse tracks first when the dataset has none and some
+// view is to be computed). Throws when a view failed. A shard (`shard`)
+// leaves its maps in OUT/raw when the consistency filter is on.
 void DepthStage(Scene* scene, const std::vector<int>& views, ImageCache& images,
                 const ReconstructConfig& config, ThreadPool* pool,
                 const std::string& out, bool force, bool shard,
@@ -370,8 +371,7 @@ void WriteSummary(const std::string& path, size_t views, const StageResults& r,
   if (r.sparse_ran) sum << ", " << r.sparse.points << " sparse points";
   if (r.depth_ran) {
     sum << " (" << r.depth.computed << " computed, " << r.depth.skipped
-        << " resumed";
-    sum << "), " << r.depth.samples << " valid depth samples";
+        << " resumed), " << r.depth.samples << " valid depth samples";
     if (r.depth.unfiltered > 0) {
       sum << " (before the consistency filter of 'wild_mvs fuse', "
           << r.depth.unfiltered << " views)";

@@ -116,6 +116,8 @@ void ExpectSameResults(const std::string& a_dir, const std::string& b_dir,
   EXPECT_EQ(CountTempFiles(b_dir), 0);
 }
 
+const char kStages[] = " --stages depth,fuse";
+
 class CliShard : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -131,7 +133,7 @@ class CliShard : public ::testing::Test {
     testing::WriteDataset(scene, dataset_);
     single_ = root_ + "/single";
     sharded_ = root_ + "/sharded";
-    const std::string common = " --stages depth,fuse";
+    const std::string common = kStages;
     single_run_ = RunCli(
         "reconstruct '" + dataset_ + "' '" + single_ + "' --threads 2" + common,
         root_ + "/single.log");
@@ -154,25 +156,6 @@ class CliShard : public ::testing::Test {
     }
     fuse_run_ =
         RunCli("fuse '" + sharded_ + "' --threads 2", root_ + "/fuse.log");
-
-    // Without the consistency filter: shards write final maps; 2 at once.
-    const std::string nf = common + " --mvs.consistency.enabled false";
-    single_nf_run_ = RunCli("reconstruct '" + dataset_ + "' '" + root_ +
-                                "/single_nf' --threads 2" + nf,
-                            root_ + "/single_nf.log");
-    const std::string sharded_nf = root_ + "/sharded_nf";
-    RunCli("reconstruct '" + dataset_ + "' '" + sharded_nf +
-               "' --threads 1 --stages sparse",
-           root_ + "/sparse_nf.log");
-    const pid_t p1 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_nf +
-                               "' --threads 1 --shard 1/2" + nf,
-                           root_ + "/shard_nf1.log");
-    const pid_t p2 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_nf +
-                               "' --threads 1 --shard 2/2" + nf,
-                           root_ + "/shard_nf2.log");
-    shards_nf_status_ = Wait(p1) == 0 && Wait(p2) == 0;
-    fuse_nf_run_ =
-        RunCli("fuse '" + sharded_nf + "' --threads 2", root_ + "/fuse_nf.log");
   }
   static void TearDownTestSuite() {
     std::error_code ec;
@@ -181,16 +164,12 @@ class CliShard : public ::testing::Test {
   static std::vector<std::string> stems_;
   static std::string root_, dataset_, single_, sharded_;
   static RunResult single_run_, sparse_run_, fuse_run_;
-  static RunResult single_nf_run_, fuse_nf_run_;
-  static bool shards_nf_status_;
   static std::vector<RunResult> shard_runs_;
 };
 std::vector<std::string> CliShard::stems_;
 std::string CliShard::root_, CliShard::dataset_, CliShard::single_,
     CliShard::sharded_;
 RunResult CliShard::single_run_, CliShard::sparse_run_, CliShard::fuse_run_;
-RunResult CliShard::single_nf_run_, CliShard::fuse_nf_run_;
-bool CliShard::shards_nf_status_ = false;
 std::vector<RunResult> CliShard::shard_runs_;
 
 TEST_F(CliShard, ConcurrentShardsThenFuseEqualOneProcess) {
@@ -238,13 +217,34 @@ TEST_F(CliShard, ConcurrentShardsThenFuseEqualOneProcess) {
 }
 
 TEST_F(CliShard, WithoutTheConsistencyFilterShardsWriteFinalMaps) {
-  ASSERT_EQ(single_nf_run_.status, 0) << single_nf_run_.output;
-  ASSERT_TRUE(shards_nf_status_) << ReadFile(root_ + "/shard_nf1.log")
-                                 << ReadFile(root_ + "/shard_nf2.log");
-  ASSERT_EQ(fuse_nf_run_.status, 0) << fuse_nf_run_.output;
+  ASSERT_EQ(single_run_.status, 0) << single_run_.output;
+  // Without the consistency filter: shards write final maps; 2 at once.
+  const std::string nf =
+      std::string(kStages) + " --mvs.consistency.enabled false";
+  const RunResult single_nf = RunCli("reconstruct '" + dataset_ + "' '" +
+                                         root_ + "/single_nf' --threads 2" + nf,
+                                     root_ + "/single_nf.log");
+  const std::string sharded_nf = root_ + "/sharded_nf";
+  RunCli("reconstruct '" + dataset_ + "' '" + sharded_nf +
+             "' --threads 1 --stages sparse",
+         root_ + "/sparse_nf.log");
+  const pid_t p1 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_nf +
+                             "' --threads 1 --shard 1/2" + nf,
+                         root_ + "/shard_nf1.log");
+  const pid_t p2 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_nf +
+                             "' --threads 1 --shard 2/2" + nf,
+                         root_ + "/shard_nf2.log");
+  const bool shards_nf_ok = Wait(p1) == 0 && Wait(p2) == 0;
+  const RunResult fuse_nf =
+      RunCli("fuse '" + sharded_nf + "' --threads 2", root_ + "/fuse_nf.log");
+
+  ASSERT_EQ(single_nf.status, 0) << single_nf.output;
+  ASSERT_TRUE(shards_nf_ok) << ReadFile(root_ + "/shard_nf1.log")
+                            << ReadFile(root_ + "/shard_nf2.log");
+  ASSERT_EQ(fuse_nf.status, 0) << fuse_nf.output;
   EXPECT_FALSE(fs::exists(root_ + "/sharded_nf/raw"));
-  EXPECT_EQ(fuse_nf_run_.output.find("filtered"), std::string::npos)
-      << fuse_nf_run_.output;
+  EXPECT_EQ(fuse_nf.output.find("filtered"), std::string::npos)
+      << fuse_nf.output;
   ExpectSameResults(root_ + "/single_nf", root_ + "/sharded_nf",
                     {"depth", "normal", "confidence", "cameras"});
   // The filter changes the maps: the comparison above is not vacuous.
