@@ -130,7 +130,7 @@ bool ReadSparseTracks(const std::string& path, const Scene& scene,
     if (!ss || count < 0) fail("bad point count");
   }
   std::vector<SparsePoint> result;
-  result.reserve(static_cast<size_t>(count));
+  // No reserve(count): a corrupt count must not allocate; the lines do.
   for (long long i = 0; i < count; ++i) {
     next();
     std::istringstream ss(line);
