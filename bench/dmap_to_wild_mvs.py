@@ -132,7 +132,8 @@ def main(argv):
     for sub in ("depth", "cameras") + (("confidence",) if confidence else ()):
         os.makedirs(os.path.join(out, sub), exist_ok=True)
     maps = [read_dmap(p) for p in paths]
-    names = {d["ids"][0]: stem_of(d["image"]) for d in maps}
+    # Neighbours by image file name (the scene's view names).
+    names = {d["ids"][0]: d["image"].replace("\\", "/").split("/")[-1] for d in maps}
     total = 0
     for p, d in zip(paths, maps):
         s = stem_of(d["image"])

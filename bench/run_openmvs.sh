@@ -24,7 +24,9 @@
 # depth folder (OUT/NAME/wild) and scored there.
 #
 # Usage: bench/run_openmvs.sh [--threads N] [--out DIR] [--only temple|fountain]
-#                             [--cloud] [--keep-going] [-- EXTRA DensifyPointCloud ARGS]
+#                             [--cloud] [--score-only] [-- EXTRA DensifyPointCloud ARGS]
+# --score-only: do not run OpenMVS, score the outputs already in OUT.
+# Writes OUT/NAME/summary.txt per dataset (and prints it).
 # Environment: OPENMVS_BIN (folder with InterfaceCOLMAP and DensifyPointCloud;
 #   default /work/ext/openmvs-build/bin), WILD_MVS_BIN (folder with wild_mvs
 #   and bench_depth_stats; default devel/lib/wild_mvs of the repo, else
@@ -44,6 +46,7 @@ THREADS=2
 OUT=""
 ONLY=""
 CLOUD=0
+SCORE_ONLY=0
 EXTRA=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -51,6 +54,7 @@ while [ $# -gt 0 ]; do
     --out) OUT="$2"; shift 2 ;;
     --only) ONLY="$2"; shift 2 ;;
     --cloud) CLOUD=1; shift ;;
+    --score-only) SCORE_ONLY=1; shift ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     --) shift; EXTRA=("$@"); break ;;
     *) echo "run_openmvs.sh: unknown option $1 (--help)" >&2; exit 2 ;;
@@ -102,21 +106,30 @@ prepare() {
     while read -r name; do ln -s "$images/$name" "$dir/images/$name"; done
 }
 
-# openmvs NAME MODEL IMAGES: InterfaceCOLMAP + DensifyPointCloud in OUT/NAME,
+# openmvs NAME MODEL IMAGES: InterfaceCOLMAP + DensifyPointCloud in OUT/NAME
+# (openmvs_run; skipped with --score-only),
 # then the depth maps as a wild_mvs folder OUT/NAME/wild.
 openmvs() {
-  local name="$1" d="$OUT/$1"
+  local d="$OUT/$1"
   mkdir -p "$d"
+  if [ "$SCORE_ONLY" = 0 ]; then
+    openmvs_run "$@"
+  fi
+  rm -rf "$d/wild"
+  python3 "$ROOT/bench/dmap_to_wild_mvs.py" --confidence "$d/wild" "$d"/depth*.dmap \
+    | tee "$d/convert.txt" >&2
+}
+
+openmvs_run() {
+  local d="$OUT/$1"
   prepare "$@"
-  rm -f "$d"/depth*.dmap "$d"/scene*.mvs "$d"/scene*.ply
+  rm -f "$d"/depth*.dmap "$d"/scene*.mvs "$d"/scene*.ply "$d"/InterfaceCOLMAP-*.log \
+    "$d"/DensifyPointCloud-*.log
   timed "$d/interface" "$OPENMVS_BIN/InterfaceCOLMAP" -w "$d" \
     -i "$d/colmap/" -o "$d/scene.mvs" --image-folder "$d/colmap/images/"
   timed "$d/densify" "$OPENMVS_BIN/DensifyPointCloud" -w "$d" \
     -i "$d/scene.mvs" -o "$d/scene_dense.mvs" --max-threads "$THREADS" \
     ${EXTRA[@]+"${EXTRA[@]}"}
-  rm -rf "$d/wild"
-  python3 "$ROOT/bench/dmap_to_wild_mvs.py" --confidence "$d/wild" "$d"/depth*.dmap \
-    | tee "$d/convert.txt" >&2
 }
 
 # kv KEY FILE: value of KEY=... on the TOTAL line.
@@ -124,8 +137,6 @@ kv() { grep '^TOTAL' "$2" | tr ' ' '\n' | sed -n "s/^$1=//p" | grep . || echo -;
 
 T="$DATASETS/middlebury_templeSparseRing"
 F="$DATASETS/strecha_fountain-P11"
-SUMMARY="$OUT/summary.txt"
-: >"$SUMMARY"
 if [ -z "$ONLY" ] || [ "$ONLY" = temple ]; then
   openmvs temple "$T/colmap_sift_gt" "$T"
   "$WILD_MVS_BIN/bench_depth_stats" "$T/colmap_sift_gt" "$T" "$OUT/temple/wild" \
@@ -141,8 +152,8 @@ if [ -z "$ONLY" ] || [ "$ONLY" = temple ]; then
     echo "temple: samples=$samples in_bbox=$(kv in_bbox "$OUT/temple/stats.txt")" \
       "correct=$correct (in box +5 mm and consistent within 0.5 %)" \
       "correct_per_cpu_s=$(echo "$correct / $cpu" | bc -l | xargs printf %.0f)"
-    echo "temple: fused cloud $(grep -m1 'element vertex' "$OUT/temple/scene_dense.ply" | awk '{print $3}') points"
-  } | tee -a "$SUMMARY"
+    echo "temple: fused cloud $(grep -a -m1 'element vertex' "$OUT/temple/scene_dense.ply" | awk '{print $3}') points"
+  } | tee "$OUT/temple/summary.txt"
 fi
 if [ -z "$ONLY" ] || [ "$ONLY" = fountain ]; then
   openmvs fountain "$F/colmap_sift_gt" "$F/images"
@@ -165,7 +176,7 @@ if [ -z "$ONLY" ] || [ "$ONLY" = fountain ]; then
   fi
   read -r cpu rss wall < <(time_field "$OUT/fountain/densify.time")
   read -r icpu _ _ < <(time_field "$OUT/fountain/interface.time")
-  python3 - "$OUT/fountain/eval_depth.json" "$cpu" "$rss" "$wall" "$icpu" <<'EOF' | tee -a "$SUMMARY"
+  python3 - "$OUT/fountain/eval_depth.json" "$cpu" "$rss" "$wall" "$icpu" <<'EOF' | tee "$OUT/fountain/summary.txt"
 import json, sys
 j = json.load(open(sys.argv[1]))
 cpu, rss, wall, icpu = float(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5]
@@ -183,4 +194,4 @@ print(f"fountain: samples={j['estimated']} gt_pixels={j['gt_valid']} "
       + (f" cloud_represented={j['cloud_represented']:.4f}" if "cloud_represented" in j else ""))
 EOF
 fi
-echo "(outputs in $OUT; summary in $SUMMARY)" >&2
+echo "(outputs in $OUT; summaries in $OUT/*/summary.txt)" >&2
