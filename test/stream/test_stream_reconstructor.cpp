@@ -208,6 +208,84 @@ TEST(StreamReconstructor, KeyframeSelectionOrderAndResets) {
   EXPECT_TRUE(c.results.empty());
 }
 
+// The keyframe test runs on the pose alone: the image of a frame that is not
+// kept is never made (the node decodes and undistorts only keyframes), and
+// a frame whose image cannot be made is dropped without becoming one.
+TEST(StreamReconstructor, OnlyKeyframeImagesAreMade) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.min_neighbors = 100;  // selection only
+  o.idle_flush = 1e6;
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  using S = StreamReconstructor::FrameStatus;
+  int made = 0;
+  auto image_of = [&](int i) {
+    return [&, i](Camera*, cv::Mat* image) {
+      ++made;
+      *image = s.images[i];
+      return true;
+    };
+  };
+  const uint64_t t0 = 1795000000000000000ull;  // epoch stamps (ns)
+  const uint64_t dt = 33333333ull;             // 30 Hz
+  // Frame 0, then 9 frames at the same pose (a robot standing still),
+  // then frame 1's pose.
+  EXPECT_EQ(stream.AddFrame(t0, "cam", s.scene.views[0].camera, image_of(0)),
+            S::kKeyframe);
+  for (int k = 1; k < 10; ++k)
+    EXPECT_EQ(stream.AddFrame(t0 + k * dt, "cam", s.scene.views[0].camera,
+                              image_of(0)),
+              S::kNotKeyframe);
+  EXPECT_EQ(made, 1);
+  // A keyframe whose image fails: dropped, not kept.
+  EXPECT_EQ(stream.AddFrame(t0 + 10 * dt, "cam", s.scene.views[1].camera,
+                            [&](Camera*, cv::Mat*) { return false; }),
+            S::kDropped);
+  EXPECT_EQ(stream.Stats().keyframes, 1u);
+  // The image function may change the intrinsics (undistortion): the
+  // keyframe keeps the camera it returns.
+  Camera undistorted;
+  EXPECT_EQ(stream.AddFrame(t0 + 11 * dt, "cam", s.scene.views[1].camera,
+                            [&](Camera* cam, cv::Mat* image) {
+                              cam->fx *= 1.01;
+                              undistorted = *cam;
+                              *image = s.images[1];
+                              return true;
+                            }),
+            S::kKeyframe);
+  EXPECT_EQ(stream.Stats().keyframes, 2u);
+  EXPECT_EQ(stream.Stats().frames, 12u);
+  EXPECT_DOUBLE_EQ(undistorted.fx, s.scene.views[1].camera.fx * 1.01);
+}
+
+// Tick() is cheap when nothing changed: no scheduling pass (store snapshot
+// and view selection) until a keyframe, points or a finished map arrive,
+// and one idle flush per quiet spell.
+TEST(StreamReconstructor, TickSchedulesOnlyWhenSomethingChanged) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.min_neighbors = 100;  // keyframes never ready: they stay schedulable
+  o.idle_flush = 0.05;
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  for (int i = 0; i < 3; ++i)
+    stream.AddFrame(double(i), "cam", s.scene.views[i].camera, s.images[i]);
+  const uint64_t after_frames = stream.Stats().scheduling_passes;
+  EXPECT_GE(after_frames, 2u);  // the 2nd and 3rd keyframe scheduled
+  // Wait for the quiet spell: the first Tick then flushes once.
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (int k = 0; k < 100; ++k) stream.Tick();
+  EXPECT_EQ(stream.Stats().scheduling_passes, after_frames + 1);
+  // New points: scheduled at once (not by a Tick).
+  stream.SetSparsePoints(StampedPoints(s));
+  EXPECT_EQ(stream.Stats().scheduling_passes, after_frames + 2);
+  for (int k = 0; k < 100; ++k) stream.Tick();
+  EXPECT_EQ(stream.Stats().scheduling_passes, after_frames + 2);
+}
+
 TEST(StreamReconstructor, StoreStaysBoundedOnALongStream) {
   const SyntheticScene& s = Scene6();
   StreamOptions o = FastOptions();
