@@ -4,6 +4,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
+#include <std_srvs/Trigger.h>
 
 #include <atomic>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "wild_mvs/ros/bus_stats.h"
 #include "wild_mvs/ros/depth_inputs.h"
 #include "wild_mvs/ros/depth_messages.h"
+#include "wild_mvs/ros/live_params.h"
 #include "wild_mvs/ros/params_ros.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
@@ -40,6 +42,12 @@ struct DepthNode::Impl {
   // of the updater, which is destroyed first).
   std::unique_ptr<RateStatus> frame_rate, map_rate;
   std::unique_ptr<diagnostic_updater::Updater> updater;
+  // Live tuning (dynamic_reconfigure protocol) over a copy of the options,
+  // and ~reset.
+  DepthNodeOptions live;
+  OptionRegistry live_registry;
+  std::unique_ptr<LiveParams> live_params;
+  ros::ServiceServer reset_srv;
   std::atomic<uint64_t> evictions_reported{0};
   DropCounter evictions;         // throttles the warning below
   RoscppDropWatch roscpp_drops;  // roscpp's own queue drops, into `drops`
@@ -138,6 +146,14 @@ struct DepthNode::Impl {
     }
   }
 
+  bool OnReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+    stream->Reset();
+    res.success = true;
+    res.message = "keyframes and tracks cleared; a new session starts";
+    ROS_INFO("%s: ~reset: %s", pnh.getNamespace().c_str(), res.message.c_str());
+    return true;
+  }
+
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     roscpp_drops.Update(inputs->QueueParams(), &drops);
     const StreamStats s = stream->Stats();
@@ -215,6 +231,21 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.tick_timer = m.nh.createSteadyTimer(
       ros::WallDuration(0.2),
       [&m](const ros::SteadyTimerEvent&) { m.stream->Tick(); });
+  // Live: the keyframe thresholds and the main MVS thresholds.
+  m.live = m.options;
+  RegisterOptions(&m.live_registry, "", &m.live);
+  m.live_params = std::make_unique<LiveParams>(
+      m.pnh, &m.live_registry,
+      std::vector<std::string>{
+          "keyframe_min_baseline", "keyframe_min_angle_deg",
+          "mvs.max_image_size", "mvs.global.num_neighbors", "mvs.local.min_ncc",
+          "mvs.mpgc.drop_ncc", "mvs.mpgc.accept_ncc", "mvs.mpgc.min_facing",
+          "mvs.mpgc.min_texture_levels", "mvs.growing.revisit_margin"},
+      [&m] {
+        m.live.Check();
+        m.stream->SetOptions(m.live.stream);
+      });
+  m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
   m.queue->Start();  // the front-end thread
   ROS_INFO(
       "%s: worker %d of %d, images %s (%s%s), camera_info %s (%s), pose "

@@ -234,6 +234,20 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
   return status;
 }
 
+void StreamReconstructor::SetOptions(const StreamOptions& options) {
+  options.Check();
+  std::lock_guard<std::mutex> lock(mutex_);
+  options_.keyframes = options.keyframes;
+  options_.mvs = options.mvs;
+  // The new thresholds may make waiting keyframes ready.
+  ScheduleLocked();
+}
+
+StreamOptions StreamReconstructor::Options() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return options_;
+}
+
 bool StreamReconstructor::IsOutOfOrder(uint64_t stamp_ns) const {
   const double stamp = StampSeconds(stamp_ns);
   std::lock_guard<std::mutex> lock(mutex_);
@@ -391,6 +405,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   int ref = -1;
   double session = 0;
   uint64_t session_ns = 0;
+  MvsOptions mvs;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (stopping_ || generation != generation_) {
@@ -410,6 +425,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
     session = session_;
     session_ns = session_ns_;
+    mvs = options_.mvs;  // SetOptions may change it meanwhile
   }
   StreamResult result;
   result.keyframe_id = id;
@@ -426,7 +442,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     const std::vector<KeyframePtr>& kfs = snap.keyframes;
     ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
     ViewReport report;
-    result.depth = ReconstructView(snap.scene, ref, cache, options_.mvs,
+    result.depth = ReconstructView(snap.scene, ref, cache, mvs,
                                    inner_pool_.get(), &report);
     result.depth.view = static_cast<int>(id);
     result.depth.neighbors.clear();

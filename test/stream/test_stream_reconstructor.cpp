@@ -286,6 +286,39 @@ TEST(StreamReconstructor, TickSchedulesOnlyWhenSomethingChanged) {
   EXPECT_EQ(stream.Stats().scheduling_passes, after_frames + 2);
 }
 
+// Live tuning: new keyframe thresholds change the selection from the next
+// frame on; invalid options are refused and the old ones kept.
+TEST(StreamReconstructor, SetOptionsRetunesKeyframeSelectionLive) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.min_neighbors = 100;  // selection only
+  o.idle_flush = 1e6;
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  using S = StreamReconstructor::FrameStatus;
+  EXPECT_EQ(stream.AddFrame(0.0, "cam", s.scene.views[0].camera, s.images[0]),
+            S::kKeyframe);
+  // Views are 10 degrees (0.45 m) apart: with 100 m and 90 degrees no frame
+  // is a keyframe any more.
+  StreamOptions strict = stream.Options();
+  strict.keyframes.min_baseline = 100;
+  strict.keyframes.min_angle_deg = 90;
+  stream.SetOptions(strict);
+  EXPECT_EQ(stream.AddFrame(1.0, "cam", s.scene.views[1].camera, s.images[1]),
+            S::kNotKeyframe);
+  // Invalid: refused, the strict thresholds stay.
+  StreamOptions bad = strict;
+  bad.mvs.mpgc.window = 4;  // must be odd
+  EXPECT_THROW(stream.SetOptions(bad), Error);
+  EXPECT_EQ(stream.Options().mvs.mpgc.window, strict.mvs.mpgc.window);
+  EXPECT_EQ(stream.AddFrame(2.0, "cam", s.scene.views[2].camera, s.images[2]),
+            S::kNotKeyframe);
+  // Back to the defaults: the next view is a keyframe again.
+  stream.SetOptions(o);
+  EXPECT_EQ(stream.AddFrame(3.0, "cam", s.scene.views[3].camera, s.images[3]),
+            S::kKeyframe);
+}
+
 TEST(StreamReconstructor, StoreStaysBoundedOnALongStream) {
   const SyntheticScene& s = Scene6();
   StreamOptions o = FastOptions();

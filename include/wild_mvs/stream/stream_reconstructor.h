@@ -168,6 +168,12 @@ class StreamReconstructor {
   // The same with a stamp in seconds (rounded to ns; tests and tools).
   FrameStatus AddFrame(double stamp, const std::string& frame_id,
                        const Camera& camera, const cv::Mat& image);
+  // Live tuning: takes the keyframe selection (keyframes) and the MVS
+  // options (mvs) of `options` (the other fields need a restart and are
+  // ignored). Throws Error (Check()) and keeps the old ones when invalid.
+  // Keyframes reconstructed from now on use them.
+  void SetOptions(const StreamOptions& options);
+  StreamOptions Options() const;
   // True when AddFrame would return kOutOfOrder for a frame with this stamp
   // (the node drops such frames before converting them).
   bool IsOutOfOrder(uint64_t stamp_ns) const;
