@@ -16,7 +16,8 @@ if(NOT CATKIN_DEVEL_PREFIX AND
 endif()
 
 set(WILD_MVS_ROS_COMPONENTS
-  roscpp nodelet pluginlib std_msgs std_srvs sensor_msgs geometry_msgs
+  roscpp nodelet pluginlib std_msgs std_srvs sensor_msgs geometry_msgs nav_msgs
+  dynamic_reconfigure
   visualization_msgs diagnostic_msgs diagnostic_updater image_transport
   tf2 tf2_ros tf2_msgs rosbag message_generation)
 # catkin installs its setup files (setup.bash, _setup_util.py, ...) to the
@@ -51,6 +52,7 @@ generate_messages(DEPENDENCIES std_msgs sensor_msgs geometry_msgs)
 catkin_package(
   INCLUDE_DIRS include
   LIBRARIES wild_mvs_core wild_mvs_io wild_mvs_stream wild_mvs_ros
-  CATKIN_DEPENDS roscpp nodelet std_msgs std_srvs sensor_msgs geometry_msgs
+  CATKIN_DEPENDS roscpp nodelet std_msgs std_srvs sensor_msgs geometry_msgs nav_msgs
+    dynamic_reconfigure
     visualization_msgs diagnostic_msgs diagnostic_updater image_transport
     tf2 tf2_ros tf2_msgs rosbag message_runtime)

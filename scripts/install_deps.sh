@@ -8,7 +8,7 @@ export DEBIAN_FRONTEND=noninteractive
 CORE="build-essential cmake pkg-config git libgtest-dev libgmock-dev libeigen3-dev libopencv-dev \
  libpcl-dev libyaml-cpp-dev libopenexr-dev"
 ROS="catkin ros-message-generation ros-message-runtime \
- libroscpp-dev libstd-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev \
+ libroscpp-dev libstd-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure \
  ros-std-msgs ros-sensor-msgs ros-geometry-msgs \
  libcv-bridge-dev libimage-transport-dev libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev \
  libpcl-conversions-dev libpcl-ros-dev librosbag-dev librostest-dev \

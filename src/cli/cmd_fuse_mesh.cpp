@@ -51,6 +51,14 @@ int RunFuse(const CommandArgs& argv) {
                     config.image.cache_mb);
   const std::string ply = args.Get("output", out + "/fused.ply");
   const double cpu0 = CpuSeconds();
+  // Maps left in OUT/raw by `reconstruct --shard` runs: the consistency
+  // filter first (it needs every neighbour's raw map).
+  const FilterStageResult f =
+      FilterPendingViews(scene, config.mvs.consistency, out, &pool, std::cerr);
+  if (f.filtered > 0) {
+    std::cout << "filtered " << f.filtered << " depth maps (kept " << f.kept
+              << " of " << f.samples << " samples)\n";
+  }
   const FuseResult r =
       RunFuseStage(scene, &images, config, &pool, out, ply, std::cerr);
   std::cout << "fused " << r.views << " depth maps into " << r.points

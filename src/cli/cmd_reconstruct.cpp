@@ -52,6 +52,12 @@ CommandSpec ReconstructSpec() {
       {"dump-config", "", "print the effective options as YAML and exit", ""},
       {"views", "LIST",
        "only these reference views (comma-separated names or stems)", ""},
+      {"shard", "K/N",
+       "only share K of N of the (selected) views, for N concurrent "
+       "processes on one OUT (views in dataset order, every N-th from the "
+       "K-th); depth maps only, then run 'wild_mvs fuse OUT' once all "
+       "have finished (docs/SCALE.md)",
+       ""},
       {"force", "", "recompute views and outputs that already exist", ""},
       {"threads", "N", "worker threads, 0 = one per core (run.threads)",
        "run.threads"},
@@ -59,7 +65,9 @@ CommandSpec ReconstructSpec() {
        "downscale images whose longest side exceeds N pixels "
        "(image.max_image_size)",
        "image.max_image_size"},
-      {"stages", "LIST", "subset of depth,fuse,mesh (run.stages)",
+      {"stages", "LIST",
+       "subset of sparse,depth,fuse,mesh (run.stages); 'sparse' alone "
+       "computes only the sparse tracks (before --shard runs)",
        "run.stages"},
       {"mask-dir", "DIR",
        "per-image masks DIR/<image name or stem>.png, 0 = ignore pixel", ""},
@@ -72,7 +80,11 @@ CommandSpec ReconstructSpec() {
       "Option precedence: defaults < --preset < --config file < "
       "command-line flags.\n"
       "Example: wild_mvs reconstruct data/templeSparseRing /tmp/temple "
-      "--max-image-size 320";
+      "--max-image-size 320\n"
+      "Sharded (docs/SCALE.md): wild_mvs reconstruct DATA OUT --stages "
+      "sparse (only for datasets without sparse points); then\n"
+      "  wild_mvs reconstruct DATA OUT --shard K/N  for K = 1..N, in any "
+      "order or concurrently; then wild_mvs fuse OUT; wild_mvs mesh OUT";
   return s;
 }
 
@@ -198,35 +210,108 @@ void WriteRunRecord(const std::string& out, const OptionSet& record_set) {
   });
 }
 
+// OUT/run.yaml for a --shard process: written when missing (with run.* at
+// their defaults, so that concurrent shards write the same bytes), else
+// checked: every shard of one OUT must use the same dataset and options
+// (run.* aside), which `wild_mvs fuse` then reads.
+void WriteOrCheckShardRunRecord(const std::string& out, const Args& args,
+                                const ReconstructConfig& config,
+                                const DatasetRecord& record) {
+  ReconstructConfig normalized = config;
+  normalized.run = RunOptions();
+  DatasetRecord record_copy = record;
+  OptionSet now;
+  RegisterOptions(&normalized, &now);
+  RegisterDatasetRecord(&record_copy, &now);
+  const std::string path = RunRecordPath(out);
+  if (!fs::exists(path) || args.Has("force")) {
+    WriteRunRecord(out, now);
+    return;
+  }
+  ReconstructConfig before;
+  DatasetRecord before_record;
+  OptionSet previous;
+  RegisterOptions(&before, &previous);
+  RegisterDatasetRecord(&before_record, &previous);
+  previous.LoadYamlFile(path);
+  for (size_t i = 0; i < now.options().size(); ++i) {
+    const auto& a = now.options()[i];
+    const auto& b = previous.options()[i];
+    if (a.key().rfind("run.", 0) == 0 || a.Text() == b.Text()) continue;
+    throw Error(Msg(path, ": ", a.key(), " is ", b.Text(), " there but ",
+                    a.Text(),
+                    " in this shard: every shard of one OUT must run on the "
+                    "same dataset with the same options (use another OUT, or "
+                    "--force to overwrite the record)"));
+  }
+}
+
 // What the stages did.
 struct StageResults {
   DepthStageResult depth;
   bool depth_ran = false;
+  SparseSummary sparse;
+  bool sparse_ran = false;
   FuseResult fuse;
   bool fused_now = false;
   MeshResult mesh;
   bool meshed = false;
 };
 
+// The sparse tracks of a dataset without sparse points (scene->points
+// empty): those of an earlier run on OUT when they match
+// (OUT/sparse/tracks.txt), else computed and saved there; a shard never
+// computes them (every shard would, at the cost of the whole tracker) and
+// asks for a `--stages sparse` run first.
+void SparseTracks(Scene* scene, const ReconstructConfig& config,
+                  ThreadPool* pool, const std::string& out,
+                  const std::vector<std::string>& fingerprint, bool force,
+                  bool shard, const std::string& dataset, StageResults* r,
+                  std::ostream& log) {
+  if (!scene->points.empty()) return;
+  // --force recomputes them, except in a shard (which never computes them).
+  if ((!force || shard) && LoadSceneTracks(scene, out, fingerprint, log)) {
+    return;
+  }
+  if (shard) {
+    throw Error(Msg(
+        dataset, ": the dataset has no sparse points and ",
+        SparseTracksPath(out),
+        " holds none for these views and options; compute them once before "
+        "starting the shards: wild_mvs reconstruct ",
+        dataset, " ", out,
+        " --stages sparse (with the shards' options), then run the shards"));
+  }
+  r->sparse =
+      ComputeAndSaveSceneTracks(scene, config, pool, out, fingerprint, log);
+  r->sparse_ran = true;
+}
+
 // The depth stage (sparse tracks first when the dataset has none and some
-// view is to be computed). Throws when a view failed.
+// view is to be computed). Throws when a view failed. A shard (`shard`)
+// leaves its maps in OUT/raw when the consistency filter is on.
 void DepthStage(Scene* scene, const std::vector<int>& views, ImageCache& images,
                 const ReconstructConfig& config, ThreadPool* pool,
-                const std::string& out, bool force, StageResults* r,
+                const std::string& out, bool force, bool shard,
+                const std::vector<std::string>& fingerprint,
+                const std::string& dataset, StageResults* r,
                 std::ostream& log) {
+  const bool raw_counts = shard && config.mvs.consistency.enabled;
   int todo = 0;
   for (int v : views) {
-    todo += (force || !ViewOutputsComplete(out, scene->views[v].Stem()));
+    const std::string stem = scene->views[v].Stem();
+    todo +=
+        (force || (!ViewOutputsComplete(out, stem) &&
+                   !(raw_counts && ViewOutputsComplete(out + "/raw", stem))));
   }
-  if (todo > 0 && scene->points.empty()) {
-    ComputeSceneTracks(scene, config, pool, log);
-    WriteColmapText(*scene, out + "/sparse");
-    log << "sparse: model written to " << out << "/sparse\n";
+  if (todo > 0) {
+    SparseTracks(scene, config, pool, out, fingerprint, force, shard, dataset,
+                 r, log);
   }
   log << "depth: " << views.size() << " views, " << todo << " to compute, "
       << pool->size() << " threads\n";
-  r->depth =
-      RunDepthStage(*scene, views, images, config, pool, out, force, log);
+  r->depth = RunDepthStage(*scene, views, images, config, pool, out, force, log,
+                           !shard);
   r->depth_ran = true;
   if (!r->depth.failures.empty()) {
     std::string list;
@@ -248,8 +333,11 @@ void FuseAndMeshStages(const Scene& scene, ImageCache* images,
   PointCloud cloud;
   bool have_cloud = false;
   if (config.run.HasStage("fuse")) {
-    if (!force && r->depth.computed == 0 && !earlier.fusion_options_changed &&
-        fs::exists(fused)) {
+    // Maps that --shard runs left in OUT/raw are filtered first.
+    const FilterStageResult pending =
+        FilterPendingViews(scene, config.mvs.consistency, out, pool, log);
+    if (!force && r->depth.computed == 0 && pending.filtered == 0 &&
+        !earlier.fusion_options_changed && fs::exists(fused)) {
       log << "fuse: " << fused
           << " is up to date, skipped (--force recomputes)\n";
     } else {
@@ -276,22 +364,28 @@ void FuseAndMeshStages(const Scene& scene, ImageCache* images,
 }
 
 // The summary line on stdout and OUT/summary.json.
-void WriteSummary(const std::string& out, size_t views, const StageResults& r,
+void WriteSummary(const std::string& path, size_t views, const StageResults& r,
                   double secs, double cpu, int threads) {
   std::ostringstream sum;
   sum << "summary: " << views << " views";
+  if (r.sparse_ran) sum << ", " << r.sparse.points << " sparse points";
   if (r.depth_ran) {
     sum << " (" << r.depth.computed << " computed, " << r.depth.skipped
         << " resumed), " << r.depth.samples << " valid depth samples";
+    if (r.depth.unfiltered > 0) {
+      sum << " (before the consistency filter of 'wild_mvs fuse', "
+          << r.depth.unfiltered << " views)";
+    }
   }
   if (r.fused_now) sum << ", " << r.fuse.points << " points";
   if (r.meshed) sum << ", " << r.mesh.faces << " faces";
   sum << "; " << std::fixed << std::setprecision(1) << secs << " s, " << cpu
       << " CPU-s, peak RSS " << std::setprecision(0) << PeakRssMb() << " MB";
   std::cout << sum.str() << "\n";
-  WriteFileAtomically(out + "/summary.json", [&](std::ostream& os) {
+  WriteFileAtomically(path, [&](std::ostream& os) {
     os << "{\n  \"views\": " << views
        << ",\n  \"views_computed\": " << r.depth.computed
+       << ",\n  \"views_unfiltered\": " << r.depth.unfiltered
        << ",\n  \"views_resumed\": " << r.depth.skipped
        << ",\n  \"valid_samples\": " << r.depth.samples
        << ",\n  \"fused_points\": " << (r.fused_now ? r.fuse.points : 0)
@@ -322,15 +416,26 @@ int RunReconstruct(const CommandArgs& argv) {
   }
   const auto t0 = std::chrono::steady_clock::now();
   const double cpu0 = CpuSeconds();
-  const std::string out = args.positional(1);
+  const std::string dataset = args.positional(0), out = args.positional(1);
   const bool force = args.Has("force");
+  const bool sharded = args.Has("shard");
+  const Shard shard = sharded ? ParseShard(args.Get("shard")) : Shard();
+  if (sharded && !config.run.HasStage("depth")) {
+    throw UsageError(Msg("--shard ", args.Get("shard"), " with --stages ",
+                         config.run.stages,
+                         ": a shard computes depth maps (run the sparse stage "
+                         "without --shard, fuse and mesh with 'wild_mvs fuse' "
+                         "and 'wild_mvs mesh')"));
+  }
   std::ostream& log = std::cerr;
 
   // Output folder and run record.
   CreateOutputFolder(out);
   DatasetRecord record = MakeDatasetRecord(args);
   const EarlierRun earlier =
-      CompareWithEarlierRun(out, force, command.options(), record, log);
+      sharded
+          ? EarlierRun()
+          : CompareWithEarlierRun(out, force, command.options(), record, log);
   OptionSet record_set;
   ReconstructConfig record_config = config;
   RegisterOptions(&record_config, &record_set);
@@ -339,26 +444,66 @@ int RunReconstruct(const CommandArgs& argv) {
   // Scene.
   std::vector<int> views;
   Scene scene = SetUpScene(args, config, record, &views, log);
+  const size_t selected = views.size();
+  if (sharded) {
+    views = ShardViews(views, shard);
+    log << "shard " << shard.index << "/" << shard.count << ": " << views.size()
+        << " of " << selected << " views\n";
+  }
   // Written before the long work so that `fuse OUT` works on partial runs;
-  // this also proves that OUT is writable.
-  WriteRunRecord(out, record_set);
+  // this also proves that OUT is writable. Shards share it: written once.
+  // A sparse-only run leaves it to the depth runs (the tracks file records
+  // the options it depends on), so its other options need not match theirs.
+  if (sharded) {
+    WriteOrCheckShardRunRecord(out, args, config, record);
+  } else if (config.run.HasStage("depth") || config.run.HasStage("fuse") ||
+             config.run.HasStage("mesh")) {
+    WriteRunRecord(out, record_set);
+  }
 
   // Stages.
   ThreadPool pool(config.run.threads);
   ImageCache images(MakeSceneLoader(scene, config.image),
                     config.image.cache_mb);
   StageResults results;
-  if (config.run.HasStage("depth")) {
-    DepthStage(&scene, views, images, config, &pool, out, force, &results, log);
+  const std::vector<std::string> fingerprint =
+      TracksFingerprint(command.options(), record.mask_dir);
+  if (config.run.HasStage("sparse") && !config.run.HasStage("depth")) {
+    if (!scene.points.empty()) {
+      log << "sparse: the dataset has " << scene.points.size()
+          << " sparse points; nothing to compute\n";
+    }
+    SparseTracks(&scene, config, &pool, out, fingerprint, force, false, dataset,
+                 &results, log);
   }
-  FuseAndMeshStages(scene, &images, config, &pool, out, force, earlier,
-                    &results, log);
+  if (config.run.HasStage("depth")) {
+    DepthStage(&scene, views, images, config, &pool, out, force, sharded,
+               fingerprint, dataset, &results, log);
+  }
+  if (sharded) {
+    if (config.run.HasStage("fuse") || config.run.HasStage("mesh")) {
+      log << "fuse, mesh: not run by a shard (they need every shard's "
+             "maps)\n";
+    }
+  } else {
+    FuseAndMeshStages(scene, &images, config, &pool, out, force, earlier,
+                      &results, log);
+  }
 
   const double secs =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
           .count();
-  WriteSummary(out, views.size(), results, secs, CpuSeconds() - cpu0,
+  const std::string summary = sharded ? Msg(out, "/summary_shard_", shard.index,
+                                            "_of_", shard.count, ".json")
+                                      : out + "/summary.json";
+  WriteSummary(summary, views.size(), results, secs, CpuSeconds() - cpu0,
                pool.size());
+  if (sharded) {
+    std::cout << "shard " << shard.index << "/" << shard.count
+              << " finished. When all " << shard.count
+              << " shards have finished, run: wild_mvs fuse " << out
+              << " && wild_mvs mesh " << out << "\n";
+  }
   return 0;
 }
 

@@ -7,7 +7,7 @@
 namespace wild_mvs {
 namespace cli {
 namespace {
-const char* const kStages[] = {"depth", "fuse", "mesh"};
+const char* const kStages[] = {"sparse", "depth", "fuse", "mesh"};
 }  // namespace
 
 void RunOptions::Check() const {
@@ -15,12 +15,12 @@ void RunOptions::Check() const {
           " must be in [0, 4096] (0 = one per core)");
   const auto list = SplitList(stages);
   Require(!list.empty(),
-          "run.stages is empty: give a subset of depth,fuse,mesh");
+          "run.stages is empty: give a subset of sparse,depth,fuse,mesh");
   for (const std::string& s : list) {
     bool known = false;
     for (const char* k : kStages) known |= (s == k);
     Require(known, "run.stages: unknown stage '", s,
-            "' (stages are depth, fuse, mesh)");
+            "' (stages are sparse, depth, fuse, mesh)");
   }
 }
 
@@ -49,7 +49,9 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Max(4096);
   registry
       ->Add(OptionRegistry::Join(prefix, "stages"), &o->stages,
-            "stages of reconstruct: comma-separated subset of depth,fuse,mesh")
+            "stages of reconstruct: comma-separated subset of "
+            "sparse,depth,fuse,mesh (sparse alone: only the sparse tracks, "
+            "before --shard runs)")
       .Note("not empty");
 }
 

@@ -17,9 +17,11 @@
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/atomic_file.h"
+#include "wild_mvs/io/colmap.h"
 #include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/report_json.h"
+#include "wild_mvs/io/sparse_tracks_file.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -150,7 +152,7 @@ DepthStageResult RunDepthStage(const Scene& scene,
                                ImageCache& images,
                                const ReconstructConfig& config,
                                ThreadPool* pool, const std::string& out,
-                               bool force, std::ostream& log) {
+                               bool force, std::ostream& log, bool filter_now) {
   const auto t0 = Clock::now();
   DepthStageResult r;
   // With the consistency filter the MVS maps go to OUT/raw first; the
@@ -180,6 +182,11 @@ DepthStageResult RunDepthStage(const Scene& scene,
     }
     if (filter && !force && ViewOutputsComplete(raw, stem)) {
       to_filter.push_back(v);
+      if (!filter_now) {  // a shard: resumed, its raw samples counted
+        const long long samples = SamplesFromLog(LogPath(raw, stem));
+        if (samples > 0) r.samples += samples;
+        ++r.skipped;
+      }
       progress.Skip(Msg(prefix, ": matched earlier, to be filtered"));
       continue;
     }
@@ -207,7 +214,8 @@ DepthStageResult RunDepthStage(const Scene& scene,
     const int valid = map.CountValid();
     if (filter) {
       to_filter.push_back(v);
-    } else {
+    }
+    if (!filter || !filter_now) {
       r.samples += valid;
       ++r.computed;
     }
@@ -223,7 +231,9 @@ DepthStageResult RunDepthStage(const Scene& scene,
   }
   progress.Finish();
   ReleaseFreeMemory();  // the stages' peaks do not add up
-  if (filter && !to_filter.empty()) {
+  if (filter && !filter_now) {
+    r.unfiltered = static_cast<int>(to_filter.size());
+  } else if (filter && !to_filter.empty()) {
     FilterStageResult f =
         FilterDepthMaps(scene, to_filter, gc, raw, out, pool, log);
     ReleaseFreeMemory();
@@ -330,6 +340,98 @@ FilterStageResult FilterDepthMaps(const Scene& scene,
   }
   progress.Finish();
   return r;
+}
+
+FilterStageResult FilterPendingViews(const Scene& scene,
+                                     const GeometricConsistencyOptions& options,
+                                     const std::string& out, ThreadPool* pool,
+                                     std::ostream& log) {
+  FilterStageResult r;
+  if (!options.enabled) return r;
+  const std::string raw = out + "/raw";
+  std::vector<int> pending;
+  int missing = 0;
+  for (size_t i = 0; i < scene.views.size(); ++i) {
+    const std::string stem = scene.views[i].Stem();
+    const bool done = ViewOutputsComplete(out, stem);
+    if (ViewOutputsComplete(raw, stem)) {
+      if (!done) pending.push_back(static_cast<int>(i));
+    } else if (!done) {
+      ++missing;
+    }
+  }
+  if (pending.empty()) return r;
+  log << "consistency: " << pending.size() << " views matched in " << raw
+      << " but not yet filtered (e.g. by --shard runs)" << std::endl;
+  if (missing > 0) {
+    // A filtered map is final: one checked before its neighbours' maps
+    // exist is checked against fewer maps than in a single run.
+    log << "consistency: warning: " << missing << " of " << scene.views.size()
+        << " views have no depth map yet; if shards are still running, "
+           "their neighbours are filtered without them (wait for every "
+           "shard before 'wild_mvs fuse')"
+        << std::endl;
+  }
+  r = FilterDepthMaps(scene, pending, options, raw, out, pool, log);
+  if (!r.failures.empty()) {
+    std::string list;
+    for (const std::string& f : r.failures) list += "\n  " + f;
+    throw Error(Msg(r.failures.size(), " of ", pending.size(),
+                    " views failed the consistency filter:", list));
+  }
+  return r;
+}
+
+std::string SparseTracksPath(const std::string& out) {
+  return out + "/sparse/tracks.txt";
+}
+
+std::vector<std::string> TracksFingerprint(const OptionSet& options,
+                                           const std::string& mask_dir) {
+  // The tracker's own options and the image loading (size, linearisation);
+  // not run.threads: the tracks do not depend on it.
+  std::vector<std::string> f;
+  for (const auto& o : options.options()) {
+    const std::string& key = o.key();
+    if (key.rfind("tracker.", 0) == 0 || key.rfind("image.", 0) == 0) {
+      if (key == "image.cache_mb") continue;
+      f.push_back(key + " " + o.Text());
+    }
+  }
+  f.push_back("dataset.mask_dir " + mask_dir);
+  return f;
+}
+
+bool LoadSceneTracks(Scene* scene, const std::string& out,
+                     const std::vector<std::string>& fingerprint,
+                     std::ostream& log) {
+  const std::string path = SparseTracksPath(out);
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  std::string why;
+  std::vector<SparsePoint> points;
+  if (!ReadSparseTracks(path, *scene, fingerprint, &points, &why)) {
+    log << "sparse: " << path << " is of another run (" << why << "); not used"
+        << std::endl;
+    return false;
+  }
+  scene->points = std::move(points);
+  log << "sparse: " << scene->points.size() << " points read from " << path
+      << std::endl;
+  return true;
+}
+
+SparseSummary ComputeAndSaveSceneTracks(
+    Scene* scene, const ReconstructConfig& config, ThreadPool* pool,
+    const std::string& out, const std::vector<std::string>& fingerprint,
+    std::ostream& log) {
+  SparseSummary s = ComputeSceneTracks(scene, config, pool, log);
+  WriteColmapText(*scene, out + "/sparse");
+  WriteSparseTracks(SparseTracksPath(out), *scene, fingerprint);
+  log << "sparse: model written to " << out << "/sparse (tracks.txt: the "
+      << "exact tracks, reused by later runs and shards on " << out << ")"
+      << std::endl;
+  return s;
 }
 
 void RegisterDatasetRecord(DatasetRecord* r, OptionRegistry* set) {

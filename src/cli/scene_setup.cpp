@@ -90,5 +90,39 @@ std::vector<int> SelectViews(const Scene& scene, const std::string& list) {
   return out;
 }
 
+Shard ParseShard(const std::string& text) {
+  const auto bad = [&](const std::string& why) {
+    return UsageError(Msg("--shard '", text, "': ", why,
+                          " (expected K/N with 1 <= K <= N, e.g. 2/8)"));
+  };
+  const size_t slash = text.find('/');
+  if (slash == std::string::npos) throw bad("no '/'");
+  const auto number = [&](const std::string& s, const char* what) {
+    if (s.empty() || s.size() > 9 ||
+        s.find_first_not_of("0123456789") != std::string::npos) {
+      throw bad(Msg(what, " is not a positive integer"));
+    }
+    return std::stoi(s);
+  };
+  Shard shard;
+  shard.index = number(text.substr(0, slash), "K");
+  shard.count = number(text.substr(slash + 1), "N");
+  if (shard.count < 1) throw bad("N must be at least 1");
+  if (shard.index < 1 || shard.index > shard.count) {
+    throw bad("K must be in 1..N");
+  }
+  return shard;
+}
+
+std::vector<int> ShardViews(std::vector<int> views, const Shard& shard) {
+  std::sort(views.begin(), views.end());
+  std::vector<int> out;
+  for (size_t i = static_cast<size_t>(shard.index - 1); i < views.size();
+       i += static_cast<size_t>(shard.count)) {
+    out.push_back(views[i]);
+  }
+  return out;
+}
+
 }  // namespace cli
 }  // namespace wild_mvs

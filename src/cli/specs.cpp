@@ -64,7 +64,9 @@ CommandSpec FuseSpec() {
       "into OUT/fused.ply (binary PLY: position, normal, colour, confidence,\n"
       "support). Depth maps are streamed from disk (bounded memory). The\n"
       "dataset (for colours) is the one recorded in OUT/run.yaml unless\n"
-      "--dataset is given.";
+      "--dataset is given. Views matched by 'reconstruct --shard K/N' runs\n"
+      "(OUT/raw) are first given the geometric-consistency filter\n"
+      "(mvs.consistency.*), which writes their final maps to OUT.";
   s.positionals = {"OUT"};
   s.min_positionals = s.max_positionals = 1;
   s.flags = {

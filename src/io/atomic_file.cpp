@@ -22,8 +22,11 @@ std::string TempNameFor(const std::string& path) {
   static thread_local std::mt19937_64 rng{std::random_device{}()};
   const fs::path p(path);
   const std::string ext = p.extension().string();  // keep for cv::imwrite
-  return (p.parent_path() / ("." + p.stem().string() + ".tmp" +
-                             std::to_string(rng() % 1000000) + ext))
+  // The process id keeps concurrent processes writing the same file (e.g.
+  // --shard runs and their run.yaml) apart; the random part, the threads.
+  return (p.parent_path() /
+          ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
+           std::to_string(rng() % 1000000) + ext))
       .string();
 }
 

@@ -179,8 +179,8 @@ sensor_msgs::CameraInfo CameraInfoFromCamera(const Camera& camera) {
 }
 
 namespace {
-void SetPose(double qx, double qy, double qz, double qw, double x, double y,
-             double z, Camera* camera) {
+Eigen::Isometry3d MakeIsometry(double qx, double qy, double qz, double qw,
+                               double x, double y, double z) {
   for (double v : {qx, qy, qz, qw, x, y, z})
     Require(Finite(v), "pose has a non-finite value (NaN or Inf)");
   Eigen::Quaterniond q(qw, qx, qy, qz);
@@ -188,21 +188,36 @@ void SetPose(double qx, double qy, double qz, double qw, double x, double y,
   Require(n > 0.9 && n < 1.1, "pose quaternion has norm ", n,
           " (not a rotation)");
   q.normalize();
-  const Eigen::Matrix3d R_wc = q.toRotationMatrix();
-  const Eigen::Vector3d t_wc(x, y, z);
-  camera->R = R_wc.transpose();
-  camera->t = -R_wc.transpose() * t_wc;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q.toRotationMatrix();
+  T.translation() = Eigen::Vector3d(x, y, z);
+  return T;
 }
 }  // namespace
 
+Eigen::Isometry3d IsometryFromMsg(const geometry_msgs::Transform& T) {
+  return MakeIsometry(T.rotation.x, T.rotation.y, T.rotation.z, T.rotation.w,
+                      T.translation.x, T.translation.y, T.translation.z);
+}
+
+Eigen::Isometry3d IsometryFromMsg(const geometry_msgs::Pose& P) {
+  return MakeIsometry(P.orientation.x, P.orientation.y, P.orientation.z,
+                      P.orientation.w, P.position.x, P.position.y,
+                      P.position.z);
+}
+
+void SetCameraPose(const Eigen::Isometry3d& world_T_camera, Camera* camera) {
+  const Eigen::Matrix3d R_wc = world_T_camera.linear();
+  camera->R = R_wc.transpose();
+  camera->t = -R_wc.transpose() * world_T_camera.translation();
+}
+
 void SetCameraPose(const geometry_msgs::Transform& T, Camera* camera) {
-  SetPose(T.rotation.x, T.rotation.y, T.rotation.z, T.rotation.w,
-          T.translation.x, T.translation.y, T.translation.z, camera);
+  SetCameraPose(IsometryFromMsg(T), camera);
 }
 
 void SetCameraPose(const geometry_msgs::Pose& P, Camera* camera) {
-  SetPose(P.orientation.x, P.orientation.y, P.orientation.z, P.orientation.w,
-          P.position.x, P.position.y, P.position.z, camera);
+  SetCameraPose(IsometryFromMsg(P), camera);
 }
 
 geometry_msgs::Pose PoseFromCamera(const Camera& camera) {

@@ -41,32 +41,50 @@ void DepthInputs::Subscribe(FrameFn on_frame, PointsFn on_points) {
   on_frame_ = std::move(on_frame);
   on_points_ = std::move(on_points);
   const DepthNodeOptions& o = options_;
-  if (o.pose_source == "tf") {
+  if (!o.camera_extrinsic.empty()) {
+    body_T_camera_ = ParseCameraExtrinsic(o.camera_extrinsic);
+    have_extrinsic_ = true;
+  }
+  pose_frame_ = NoSlash(o.pose_frame);
+  // tf: the pose itself, or a body's camera extrinsic from /tf_static.
+  if (o.pose_source == "tf" || !have_extrinsic_) {
     tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(30.0));
     tf_listener_ =
         std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_, true);
-  } else {
-    pose_sub_ = nh_.subscribe("pose", 50, &DepthInputs::OnPose, this);
+  }
+  const int q = o.pose_queue_size;
+  if (o.pose_source == "pose" || o.pose_source == "topic") {
+    pose_sub_ = nh_.subscribe("pose", q, &DepthInputs::OnPoseStamped, this);
+  } else if (o.pose_source == "pose_with_covariance") {
+    pose_sub_ =
+        nh_.subscribe("pose", q, &DepthInputs::OnPoseWithCovariance, this);
+  } else if (o.pose_source == "transform") {
+    pose_sub_ = nh_.subscribe("pose", q, &DepthInputs::OnTransform, this);
+  } else if (o.pose_source == "odometry") {
+    pose_sub_ = nh_.subscribe("pose", q, &DepthInputs::OnOdometry, this);
   }
   if (o.sparse_source == "topic")
     points_sub_ =
         nh_.subscribe("sparse_points", 2, &DepthInputs::OnSparsePoints, this);
-  info_sub_ = nh_.subscribe(info_topic_, 20, &DepthInputs::OnInfo, this);
+  info_sub_ = nh_.subscribe(info_topic_, o.camera_info_queue_size,
+                            &DepthInputs::OnInfo, this);
   it_ = std::make_unique<image_transport::ImageTransport>(nh_);
   const std::vector<std::string> plugins = it_->getLoadableTransports();
   const bool have_plugin = std::find(plugins.begin(), plugins.end(),
                                      o.image_transport) != plugins.end();
   if (o.image_transport == "raw" || have_plugin) {
-    image_sub_ = it_->subscribe(image_topic_, 5, &DepthInputs::OnRaw, this,
-                                image_transport::TransportHints(
-                                    o.image_transport, ros::TransportHints(),
-                                    pnh_, "image_transport_hints"));
+    image_sub_ = it_->subscribe(
+        image_topic_, o.image_queue_size, &DepthInputs::OnRaw, this,
+        image_transport::TransportHints(o.image_transport,
+                                        ros::TransportHints(), pnh_,
+                                        "image_transport_hints"));
   } else if (o.image_transport == "compressed") {
     // No compressed plugin installed (Debian 12 ships none): take
     // <image>/compressed and decode it here. "image" is remapped as a
     // whole name, so it is resolved before appending.
-    compressed_sub_ = nh_.subscribe(image_topic_ + "/compressed", 5,
-                                    &DepthInputs::OnCompressed, this);
+    compressed_sub_ =
+        nh_.subscribe(image_topic_ + "/compressed", o.image_queue_size,
+                      &DepthInputs::OnCompressed, this);
   } else {
     std::string names;
     for (const std::string& p : plugins) names += " " + p;
@@ -98,8 +116,56 @@ void DepthInputs::OnInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
   infos_.Add(msg->header.stamp.toNSec(), msg);
 }
 
-void DepthInputs::OnPose(const geometry_msgs::PoseStampedConstPtr& msg) {
-  poses_.Add(msg->header.stamp.toNSec(), msg);
+void DepthInputs::OnPoseStamped(const geometry_msgs::PoseStampedConstPtr& msg) {
+  AddPose(msg->header, "", msg->pose);
+}
+
+void DepthInputs::OnPoseWithCovariance(
+    const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
+  AddPose(msg->header, "", msg->pose.pose);
+}
+
+void DepthInputs::OnTransform(
+    const geometry_msgs::TransformStampedConstPtr& msg) {
+  geometry_msgs::Pose p;
+  p.position.x = msg->transform.translation.x;
+  p.position.y = msg->transform.translation.y;
+  p.position.z = msg->transform.translation.z;
+  p.orientation = msg->transform.rotation;
+  AddPose(msg->header, msg->child_frame_id, p);
+}
+
+void DepthInputs::OnOdometry(const nav_msgs::OdometryConstPtr& msg) {
+  AddPose(msg->header, msg->child_frame_id, msg->pose.pose);
+}
+
+void DepthInputs::AddPose(const std_msgs::Header& header,
+                          const std::string& child,
+                          const geometry_msgs::Pose& pose) {
+  const std::string topic = Topic("pose");
+  if (NoSlash(header.frame_id) != options_.world_frame) {
+    drop_(topic, "pose frame_id is not the world frame",
+          "'" + header.frame_id + "' vs '" + options_.world_frame + "'");
+    return;
+  }
+  // The frame the poses are of: the messages' child_frame_id (transform,
+  // odometry) unless ~pose_frame says otherwise; one frame per stream.
+  if (!child.empty() && options_.pose_frame.empty()) {
+    const std::string frame = NoSlash(child);
+    std::lock_guard<std::mutex> lock(pose_frame_mutex_);
+    if (pose_frame_.empty()) {
+      pose_frame_ = frame;
+    } else if (frame != pose_frame_) {
+      drop_(topic, "pose child_frame_id changed (poses of one frame expected)",
+            "'" + frame + "' after '" + pose_frame_ + "'");
+      return;
+    }
+  }
+  try {
+    poses_.Add(header.stamp.toNSec(), IsometryFromMsg(pose));
+  } catch (const Error& e) {
+    drop_(topic, "invalid pose", e.what());
+  }
 }
 
 void DepthInputs::Stop() {
@@ -109,6 +175,15 @@ void DepthInputs::Stop() {
   image_sub_.shutdown();
   compressed_sub_.shutdown();
   points_sub_.shutdown();
+}
+
+std::map<std::string, std::string> DepthInputs::QueueParams() const {
+  std::map<std::string, std::string> out;
+  if (image_sub_) out[image_sub_.getTopic()] = "image_queue_size";
+  if (compressed_sub_) out[compressed_sub_.getTopic()] = "image_queue_size";
+  if (info_sub_) out[info_sub_.getTopic()] = "camera_info_queue_size";
+  if (pose_sub_) out[pose_sub_.getTopic()] = "pose_queue_size";
+  return out;
 }
 
 std::string DepthInputs::Topic(const std::string& name) const {
@@ -137,10 +212,8 @@ std::string DepthInputs::NoSlash(const std::string& frame_id) {
 
 void DepthInputs::OnSparsePoints(const wild_mvs::SparsePointsConstPtr& msg) {
   if (NoSlash(msg->header.frame_id) != options_.world_frame) {
-    drop_(Topic("sparse_points"),
-          "frame_id '" + msg->header.frame_id + "' is not the world frame '" +
-              options_.world_frame + "'",
-          "");
+    drop_(Topic("sparse_points"), "frame_id is not the world frame",
+          "'" + msg->header.frame_id + "' vs '" + options_.world_frame + "'");
     return;
   }
   on_points_(StampedPointsFromMsg(*msg));
@@ -172,8 +245,7 @@ bool DepthInputs::PairCameraInfo(DepthFrame* f) {
   return false;
 }
 
-bool DepthInputs::Convert(const DepthFrame& f, Camera* cam, cv::Mat* image) {
-  const std::string image_topic = ImageTopic(f);
+bool DepthInputs::CameraFromInfo(const DepthFrame& f, Camera* cam) {
   Distortion dist;
   try {
     CameraFromCameraInfo(*f.info, cam, &dist, rectified_);
@@ -181,6 +253,12 @@ bool DepthInputs::Convert(const DepthFrame& f, Camera* cam, cv::Mat* image) {
     drop_(info_topic_, "invalid camera_info", e.what());
     return false;
   }
+  return true;
+}
+
+bool DepthInputs::ConvertImage(const DepthFrame& f, Camera* cam,
+                               cv::Mat* image) {
+  const std::string image_topic = ImageTopic(f);
   try {
     *image = f.raw ? ImageToLinearRgb(*f.raw, options_.linearize)
                    : CompressedToLinearRgb(*f.compressed, options_.linearize);
@@ -202,7 +280,39 @@ bool DepthInputs::Convert(const DepthFrame& f, Camera* cam, cv::Mat* image) {
     drop_(info_topic_, "invalid camera_info", e.what());
     return false;
   }
-  return LookupPose(f, cam);
+  return true;
+}
+
+bool DepthInputs::BodyToCamera(const std::string& body,
+                               const std::string& camera,
+                               Eigen::Isometry3d* T) {
+  if (have_extrinsic_) {
+    *T = body_T_camera_;
+    return true;
+  }
+  // A static extrinsic: the latest transform (/tf_static), waiting up to
+  // tf_timeout of wall time for it to arrive.
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration<double>(options_.tf_timeout);
+  while (!tf_buffer_->canTransform(body, camera, ros::Time(0)) &&
+         std::chrono::steady_clock::now() < deadline && !stopping_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  try {
+    *T = IsometryFromMsg(
+        tf_buffer_->lookupTransform(body, camera, ros::Time(0)).transform);
+  } catch (const tf2::TransformException& e) {
+    drop_("tf",
+          "no camera extrinsic body <- camera (publish it on /tf_static or "
+          "set ~camera_extrinsic)",
+          body + " <- " + camera + ": " + e.what());
+    return false;
+  } catch (const Error& e) {
+    drop_("tf", "invalid camera extrinsic",
+          body + " <- " + camera + ": " + e.what());
+    return false;
+  }
+  return true;
 }
 
 // Pose of the frame from tf or the pose topic; false (and counted) when
@@ -241,29 +351,29 @@ bool DepthInputs::LookupPose(const DepthFrame& f, Camera* cam) {
     }
     return true;
   }
-  // Pose topic: the pose whose stamp is closest, within the tolerance.
-  geometry_msgs::PoseStampedConstPtr best;
-  if (!poses_.WaitNearest(f.stamp.toNSec(), o.pose_sync_tolerance, o.tf_timeout,
-                          &best)) {
-    drop_(Topic("pose"),
-          "no pose within pose_sync_tolerance of the image "
-          "stamp within tf_timeout",
-          "");
+  // Pose topic: interpolated at the image stamp (slerp + lerp between the
+  // poses around it, at most pose_max_gap apart), never extrapolated.
+  Eigen::Isometry3d world_T_frame;
+  const PoseTrack::Result r =
+      poses_.WaitAt(f.stamp.toNSec(), o.pose_sync_tolerance, o.pose_max_gap,
+                    o.tf_timeout, &world_T_frame);
+  if (!PoseTrack::Ok(r)) {
+    drop_(Topic("pose"), PoseTrack::Describe(r), "");
     return false;
   }
-  if (NoSlash(best->header.frame_id) != o.world_frame) {
-    drop_(Topic("pose"),
-          "pose frame_id '" + best->header.frame_id +
-              "' is not the world frame '" + o.world_frame + "'",
-          "");
-    return false;
+  // Poses of a body frame: T_world_camera = T_world_body * T_body_camera.
+  std::string body;
+  {
+    std::lock_guard<std::mutex> lock(pose_frame_mutex_);
+    body = pose_frame_;
   }
-  try {
-    SetCameraPose(best->pose, cam);
-  } catch (const Error& e) {
-    drop_(Topic("pose"), "invalid pose", e.what());
-    return false;
+  Eigen::Isometry3d world_T_camera = world_T_frame;
+  if (!body.empty() && body != f.frame_id) {
+    Eigen::Isometry3d body_T_camera;
+    if (!BodyToCamera(body, f.frame_id, &body_T_camera)) return false;
+    world_T_camera = world_T_frame * body_T_camera;
   }
+  SetCameraPose(world_T_camera, cam);
   return true;
 }
 

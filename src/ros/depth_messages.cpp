@@ -102,16 +102,37 @@ std::vector<StreamReconstructor::StampedPoint> StampedPointsFromMsg(
   return pts;
 }
 
+RateStatus::RateStatus(const std::string& name, double min_hz, double max_hz,
+                       int window, unsigned char quiet_level,
+                       std::string quiet_message)
+    : std::pair<double, double>(min_hz, max_hz),
+      diagnostic_updater::FrequencyStatus(
+          diagnostic_updater::FrequencyStatusParam(&first, &second, 0.1,
+                                                   window),
+          name),
+      quiet_level_(quiet_level),
+      quiet_message_(std::move(quiet_message)) {}
+
+void RateStatus::run(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  diagnostic_updater::FrequencyStatus::run(stat);
+  // FrequencyStatus says ERROR only for a window without events.
+  if (stat.level == diagnostic_msgs::DiagnosticStatus::ERROR)
+    stat.summary(quiet_level_, quiet_message_);
+}
+
 void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
                           const DropCounter& drops,
                           diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  const uint64_t dropped = drops.Total();
-  if (dropped > 0 || s.evicted_waiting > 0) {
+  // The level follows the recent window (WARN clears once drops stop); the
+  // totals stay in the values.
+  const uint64_t dropped = drops.Total(), recent = drops.RecentTotal();
+  if (recent > 0 || in.recent_evictions > 0) {
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
-                  "%lu frames dropped (see dropped: entries), %lu "
-                  "keyframes evicted before reconstruction",
-                  static_cast<unsigned long>(dropped),
-                  static_cast<unsigned long>(s.evicted_waiting));
+                  "%lu frames dropped and %lu keyframes evicted before "
+                  "reconstruction in the last %.0f s (see dropped: entries)",
+                  static_cast<unsigned long>(recent),
+                  static_cast<unsigned long>(in.recent_evictions),
+                  drops.window());
   } else {
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
   }
@@ -134,6 +155,8 @@ void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
   stat.add("last seconds per depth map", s.last_seconds);
   stat.add("mean seconds per depth map", s.mean_seconds);
   stat.add("frames dropped", dropped);
+  stat.add("frames dropped recently", recent);
+  stat.add("drop window s", drops.window());
   for (const auto& [reason, n] : drops.Counts())
     stat.add("dropped: " + reason, n);
 }

@@ -4,14 +4,18 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
+#include <std_srvs/Trigger.h>
 
 #include <atomic>
 #include <cstdio>
+#include <limits>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/ros/bus_stats.h"
 #include "wild_mvs/ros/depth_inputs.h"
 #include "wild_mvs/ros/depth_messages.h"
+#include "wild_mvs/ros/live_params.h"
 #include "wild_mvs/ros/params_ros.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
@@ -34,9 +38,19 @@ struct DepthNode::Impl {
   // Periodic work about machine time (scheduling, diagnostics): steady
   // timers, so that it goes on when /clock pauses or stops (sim time).
   ros::SteadyTimer tick_timer, diag_timer;
+  // Rates of input frames (every image received) and of depth maps (tasks
+  // of the updater, which is destroyed first).
+  std::unique_ptr<RateStatus> frame_rate, map_rate;
   std::unique_ptr<diagnostic_updater::Updater> updater;
+  // Live tuning (dynamic_reconfigure protocol) over a copy of the options,
+  // and ~reset.
+  DepthNodeOptions live;
+  OptionRegistry live_registry;
+  std::unique_ptr<LiveParams> live_params;
+  ros::ServiceServer reset_srv;
   std::atomic<uint64_t> evictions_reported{0};
-  DropCounter evictions;  // throttles the warning below
+  DropCounter evictions;         // throttles the warning below
+  RoscppDropWatch roscpp_drops;  // roscpp's own queue drops, into `drops`
 
   // Warns (throttled) when keyframes were evicted from the full keyframe
   // store before their depth map was made: reconstruction is slower than
@@ -48,7 +62,9 @@ struct DepthNode::Impl {
            !evictions_reported.compare_exchange_weak(seen, total)) {
     }
     if (seen >= total) return;
-    if (evictions.Count("evicted", nullptr))
+    bool log = false;
+    for (uint64_t k = seen; k < total; ++k) log |= evictions.Count("evicted");
+    if (log)
       ROS_WARN(
           "%s: keyframe store full: %lu keyframes so far evicted before "
           "their depth map (depth maps are made slower than keyframes "
@@ -76,6 +92,7 @@ struct DepthNode::Impl {
   }
 
   void Enqueue(DepthFrame f) {
+    if (frame_rate) frame_rate->tick();
     if (!queue->Push(std::move(f)))
       Drop(inputs->Topic("image") +
                (options.image_transport == "raw" ? "" : "/compressed"),
@@ -90,12 +107,17 @@ struct DepthNode::Impl {
       Drop(image_topic, "stamp out of order (not after the previous frame)");
       return;
     }
+    // Intrinsics and pose first: the keyframe test needs only the pose, and
+    // only a keyframe's image is decoded and undistorted.
     Camera cam;
-    cv::Mat image;
-    if (!inputs->Convert(f, &cam, &image)) return;
+    if (!inputs->CameraFromInfo(f, &cam) || !inputs->LookupPose(f, &cam))
+      return;
     StreamReconstructor::FrameStatus status;
     try {
-      status = stream->AddFrame(f.stamp.toNSec(), f.frame_id, cam, image);
+      status = stream->AddFrame(f.stamp.toNSec(), f.frame_id, cam,
+                                [this, &f](Camera* c, cv::Mat* image) {
+                                  return inputs->ConvertImage(f, c, image);
+                                });
     } catch (const Error& e) {
       Drop(image_topic, "rejected frame", e.what());
       return;
@@ -124,13 +146,23 @@ struct DepthNode::Impl {
     }
   }
 
+  bool OnReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+    stream->Reset();
+    res.success = true;
+    res.message = "keyframes and tracks cleared; a new session starts";
+    ROS_INFO("%s: ~reset: %s", pnh.getNamespace().c_str(), res.message.c_str());
+    return true;
+  }
+
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    roscpp_drops.Update(inputs->QueueParams(), &drops);
     const StreamStats s = stream->Stats();
     DepthInputStats in;
     in.received = queue->received();
     in.queued = queue->size();
     in.queue_size = options.input_queue_size;
     ReportEvictions(s.evicted_waiting);
+    in.recent_evictions = evictions.RecentTotal();
     FillDepthDiagnostics(s, in, drops, stat);
   }
 };
@@ -155,12 +187,27 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     m.options.camera_frame = m.inputs->NoSlash(m.options.camera_frame);
   m.drops.set_throttle(m.options.error_throttle);
   m.evictions.set_throttle(m.options.error_throttle);
+  m.drops.set_window(m.options.drop_window);
+  m.evictions.set_window(m.options.drop_window);
   const DepthNodeOptions& o = m.options;
 
+  // Created before any callback or worker can tick them.
+  const double inf = std::numeric_limits<double>::infinity();
+  m.frame_rate = std::make_unique<RateStatus>(
+      "rate: input frames", 0.0, inf, 10,
+      diagnostic_msgs::DiagnosticStatus::WARN,
+      "no input frame in the last 10 diagnostics periods");
+  m.map_rate = std::make_unique<RateStatus>(
+      "rate: depth maps", 0.0, inf, 10, diagnostic_msgs::DiagnosticStatus::OK,
+      "no depth map in the last 10 diagnostics periods (no new keyframe)");
   m.outputs = std::make_unique<DepthOutputs>(
       m.pnh, o.world_frame, o.depth_encoding, o.stream.worker_index);
   m.stream = std::make_unique<StreamReconstructor>(
-      o.stream, [&m](const StreamResult& r) { m.outputs->Publish(r); },
+      o.stream,
+      [&m](const StreamResult& r) {
+        m.outputs->Publish(r);
+        if (m.map_rate) m.map_rate->tick();
+      },
       [&m](const std::string& e) {
         m.Drop("reconstruction", "keyframe failed", e);
       });
@@ -176,12 +223,29 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       m.nh, m.pnh, m.pnh.getNamespace());
   m.updater->setHardwareID("wild_mvs_depth");
   m.updater->add("depth_node", &m, &Impl::Diagnose);
+  m.updater->add(*m.frame_rate);
+  m.updater->add(*m.map_rate);
   m.diag_timer = m.nh.createSteadyTimer(
       ros::WallDuration(o.diagnostics_period),
       [&m](const ros::SteadyTimerEvent&) { m.updater->force_update(); });
   m.tick_timer = m.nh.createSteadyTimer(
       ros::WallDuration(0.2),
       [&m](const ros::SteadyTimerEvent&) { m.stream->Tick(); });
+  // Live: the keyframe thresholds and the main MVS thresholds.
+  m.live = m.options;
+  RegisterOptions(&m.live_registry, "", &m.live);
+  m.live_params = std::make_unique<LiveParams>(
+      m.pnh, &m.live_registry,
+      std::vector<std::string>{
+          "keyframe_min_baseline", "keyframe_min_angle_deg",
+          "mvs.max_image_size", "mvs.global.num_neighbors", "mvs.local.min_ncc",
+          "mvs.mpgc.drop_ncc", "mvs.mpgc.accept_ncc", "mvs.mpgc.min_facing",
+          "mvs.mpgc.min_texture_levels", "mvs.growing.revisit_margin"},
+      [&m] {
+        m.live.Check();
+        m.stream->SetOptions(m.live.stream);
+      });
+  m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
   m.queue->Start();  // the front-end thread
   ROS_INFO(
       "%s: worker %d of %d, images %s (%s%s), camera_info %s (%s), pose "
@@ -219,8 +283,10 @@ class DepthNodelet : public nodelet::Nodelet {
  private:
   void onInit() override {
     try {
-      node_ =
-          std::make_unique<DepthNode>(getNodeHandle(), getPrivateNodeHandle());
+      // Multi-threaded callback queues (image, camera_info and pose
+      // callbacks, timers and services never wait for one another).
+      node_ = std::make_unique<DepthNode>(getMTNodeHandle(),
+                                          getMTPrivateNodeHandle());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
       throw;

@@ -38,11 +38,11 @@ FusionSessionOptions SessionOptions(const FusionNodeOptions& o) {
 void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
                            size_t queued, const DropCounter& drops,
                            diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  const uint64_t dropped = drops.Total();
-  if (dropped > 0)
+  const uint64_t dropped = drops.Total(), recent = drops.RecentTotal();
+  if (recent > 0)
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
-                  "%lu depth views dropped",
-                  static_cast<unsigned long>(dropped));
+                  "%lu depth views dropped in the last %.0f s",
+                  static_cast<unsigned long>(recent), drops.window());
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
   stat.add("views received", received);
@@ -60,6 +60,8 @@ void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
   stat.add("depth sessions", s.sessions);
   stat.add("session clouds saved", s.session_saves);
   stat.add("views dropped", dropped);
+  stat.add("views dropped recently", recent);
+  stat.add("drop window s", drops.window());
   for (const auto& [reason, n] : drops.Counts())
     stat.add("dropped: " + reason, n);
 }

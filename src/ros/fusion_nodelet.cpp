@@ -11,15 +11,19 @@
 #include <wild_mvs/SaveCloud.h>
 
 #include <cstdio>
+#include <limits>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/ros/bus_stats.h"
 #include "wild_mvs/ros/conversions.h"
+#include "wild_mvs/ros/depth_messages.h"
 #include "wild_mvs/ros/fusion_messages.h"
 #include "wild_mvs/ros/params_ros.h"
 #include "wild_mvs/stream/cloud_file.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/fusion_session.h"
+#include "wild_mvs/stream/periodic_worker.h"
 #include "wild_mvs/stream/work_queue.h"
 #if __has_include("wild_mvs/core/meshing.h")
 #include "wild_mvs/core/meshing.h"
@@ -33,12 +37,19 @@ struct FusionNode::Impl {
   ros::NodeHandle nh, pnh;
   FusionNodeOptions options;
   DropCounter drops;
+  RoscppDropWatch roscpp_drops;  // roscpp's own queue drops, into `drops`
   ros::Subscriber sub;
   ros::Publisher cloud_pub, mesh_pub;
   ros::ServiceServer save_srv, reset_srv;
   // Periodic work about machine time: steady timers, so that the cloud is
   // still published when /clock pauses or stops (sim time, bag ended).
-  ros::SteadyTimer publish_timer, mesh_timer, diag_timer;
+  ros::SteadyTimer diag_timer;
+  // Slow work off the callback threads: publishing (with the views that
+  // waited reorder_timeout fused first), saves and resets on one worker,
+  // meshing on another. Callbacks only queue and wait.
+  PeriodicWorker output_worker, mesh_worker;
+  // Rate of depth views received (a task of the updater, destroyed first).
+  std::unique_ptr<RateStatus> view_rate;
   std::unique_ptr<diagnostic_updater::Updater> updater;
   // Reorder buffer, session policy, spill store and the fusion itself.
   std::unique_ptr<FusionSession> session;
@@ -60,6 +71,7 @@ struct FusionNode::Impl {
   }
 
   void OnView(const wild_mvs::DepthViewConstPtr& msg) {
+    view_rate->tick();
     if (!queue->Push(msg))
       Drop("input queue full (views arrive faster than they are fused)");
   }
@@ -68,8 +80,9 @@ struct FusionNode::Impl {
   void Accept(const wild_mvs::DepthView& msg) {
     if (StripLeadingSlash(msg.camera_pose.header.frame_id) !=
         options.world_frame) {
-      Drop("camera_pose frame '" + msg.camera_pose.header.frame_id +
-           "' is not the world frame '" + options.world_frame + "'");
+      Drop("camera_pose frame is not the world frame",
+           "'" + msg.camera_pose.header.frame_id + "' vs '" +
+               options.world_frame + "'");
       return;
     }
     FusionView view;
@@ -142,7 +155,11 @@ struct FusionNode::Impl {
       return true;
     }
     try {
-      res.num_points = Save(path);
+      // On the output worker (the disk I/O never runs on a callback thread);
+      // this callback thread only waits for it.
+      size_t n = 0;
+      output_worker.Post([&] { n = Save(path); }).get();
+      res.num_points = n;
       res.success = true;
       res.message = path;
       ROS_INFO("%s: saved %lu points to %s", pnh.getNamespace().c_str(),
@@ -156,14 +173,19 @@ struct FusionNode::Impl {
   }
 
   bool OnReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-    session->Reset();
-    PublishCloud(true);
+    output_worker
+        .Post([this] {
+          session->Reset();
+          PublishCloud(true);
+        })
+        .get();
     res.success = true;
     res.message = "fused cloud cleared";
     return true;
   }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    roscpp_drops.Update({{sub.getTopic(), "input_queue_size"}}, &drops);
     const uint64_t received = queue->received();
     const size_t queued = queue->size();
     FillFusionDiagnostics(session->Stats(), received, queued, drops, stat);
@@ -190,6 +212,7 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     m.options.world_frame = w;
   }
   m.drops.set_throttle(m.options.error_throttle);
+  m.drops.set_window(m.options.drop_window);
   const FusionNodeOptions& o = m.options;
   m.session = std::make_unique<FusionSession>(
       SessionOptions(o),
@@ -210,22 +233,25 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     m.mesh_pub = m.pnh.advertise<visualization_msgs::Marker>("mesh", 1, true);
   m.save_srv = m.pnh.advertiseService("save", &Impl::OnSave, &m);
   m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
+  m.view_rate = std::make_unique<RateStatus>(
+      "rate: depth views", 0.0, std::numeric_limits<double>::infinity(), 10,
+      diagnostic_msgs::DiagnosticStatus::OK,
+      "no depth view in the last 10 diagnostics periods");
   m.sub = m.nh.subscribe("depth_view", o.input_queue_size, &Impl::OnView, &m);
-  m.publish_timer = m.nh.createSteadyTimer(
-      ros::WallDuration(o.publish_period),
-      [&m](const ros::SteadyTimerEvent&) { m.PublishCloud(false); });
+  m.output_worker.Every(o.publish_period, [&m] { m.PublishCloud(false); });
   if (o.mesh_period > 0)
-    m.mesh_timer = m.nh.createSteadyTimer(
-        ros::WallDuration(o.mesh_period),
-        [&m](const ros::SteadyTimerEvent&) { m.PublishMesh(); });
+    m.mesh_worker.Every(o.mesh_period, [&m] { m.PublishMesh(); });
   m.updater = std::make_unique<diagnostic_updater::Updater>(
       m.nh, m.pnh, m.pnh.getNamespace());
   m.updater->setHardwareID("wild_mvs_fusion");
   m.updater->add("fusion_node", &m, &Impl::Diagnose);
+  m.updater->add(*m.view_rate);
   m.diag_timer = m.nh.createSteadyTimer(
       ros::WallDuration(o.diagnostics_period),
       [&m](const ros::SteadyTimerEvent&) { m.updater->force_update(); });
   m.queue->Start();  // the fusion thread
+  m.output_worker.Start();
+  m.mesh_worker.Start();
 }
 
 size_t FusionNode::Save(const std::string& path) { return impl_->Save(path); }
@@ -233,9 +259,10 @@ size_t FusionNode::Save(const std::string& path) { return impl_->Save(path); }
 FusionNode::~FusionNode() {
   Impl& m = *impl_;
   m.sub.shutdown();
-  m.publish_timer.stop();
-  m.mesh_timer.stop();
   m.diag_timer.stop();
+  // A running mesh or publication finishes; nothing new starts.
+  m.mesh_worker.Stop();
+  m.output_worker.Stop();
   // Views already queued are fused before the final save.
   for (const auto& msg : m.queue->Stop()) {
     try {
@@ -264,8 +291,10 @@ class FusionNodelet : public nodelet::Nodelet {
  private:
   void onInit() override {
     try {
-      node_ =
-          std::make_unique<FusionNode>(getNodeHandle(), getPrivateNodeHandle());
+      // Multi-threaded callback queues: a service or timer never holds up
+      // the depth_view callback.
+      node_ = std::make_unique<FusionNode>(getMTNodeHandle(),
+                                           getMTPrivateNodeHandle());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
       throw;

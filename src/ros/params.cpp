@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include "wild_mvs/core/error.h"
 
@@ -103,8 +104,21 @@ std::vector<std::string> UnknownParams(const ParamSource& params,
 
 void DepthNodeOptions::Check() const {
   Require(!world_frame.empty(), "world_frame must not be empty");
-  Require(pose_source == "tf" || pose_source == "topic", "pose_source = '",
-          pose_source, "' must be 'tf' or 'topic'");
+  Require(pose_source == "tf" || pose_source == "topic" ||
+              pose_source == "pose" || pose_source == "pose_with_covariance" ||
+              pose_source == "transform" || pose_source == "odometry",
+          "pose_source = '", pose_source,
+          "' must be tf, pose (or topic), pose_with_covariance, transform or "
+          "odometry");
+  Require(
+      std::isfinite(pose_max_gap) && pose_max_gap >= 0 && pose_max_gap <= 10,
+      "pose_max_gap = ", pose_max_gap, " must be in [0, 10] s");
+  for (const auto& [name, q] :
+       {std::pair<const char*, int>{"pose_queue_size", pose_queue_size},
+        {"image_queue_size", image_queue_size},
+        {"camera_info_queue_size", camera_info_queue_size}})
+    Require(q >= 1 && q <= 10000, name, " = ", q, " must be in [1, 10000]");
+  if (!camera_extrinsic.empty()) ParseCameraExtrinsic(camera_extrinsic);
   Require(!image_transport.empty() &&
               image_transport.find_first_of("/ ") == std::string::npos,
           "image_transport = '", image_transport,
@@ -126,7 +140,30 @@ void DepthNodeOptions::Check() const {
           "diagnostics_period = ", diagnostics_period, " must be > 0");
   Require(std::isfinite(error_throttle) && error_throttle >= 0,
           "error_throttle = ", error_throttle, " must be >= 0");
+  Require(
+      std::isfinite(drop_window) && drop_window >= 0.1 && drop_window <= 86400,
+      "drop_window = ", drop_window, " must be in [0.1, 86400] s");
   stream.Check();
+}
+
+Eigen::Isometry3d ParseCameraExtrinsic(const std::string& text) {
+  std::istringstream in(text);
+  double v[7];
+  for (double& x : v) in >> x;
+  std::string rest;
+  Require(static_cast<bool>(in) && !(in >> rest), "camera_extrinsic = '", text,
+          "' must be 7 numbers: x y z qx qy qz qw (the camera optical frame "
+          "in the body frame)");
+  for (double x : v)
+    Require(std::isfinite(x), "camera_extrinsic = '", text,
+            "' has a non-finite value");
+  Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  Require(std::abs(q.norm() - 1.0) < 1e-3, "camera_extrinsic = '", text,
+          "': the quaternion qx qy qz qw has norm ", q.norm(), " (must be 1)");
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return T;
 }
 
 void FusionNodeOptions::Check() const {
@@ -141,6 +178,9 @@ void FusionNodeOptions::Check() const {
           "diagnostics_period = ", diagnostics_period, " must be > 0");
   Require(std::isfinite(error_throttle) && error_throttle >= 0,
           "error_throttle = ", error_throttle, " must be >= 0");
+  Require(
+      std::isfinite(drop_window) && drop_window >= 0.1 && drop_window <= 86400,
+      "drop_window = ", drop_window, " must be in [0.1, 86400] s");
   Require(max_published_points >= 0,
           "max_published_points = ", max_published_points, " must be >= 0");
   Require(std::isfinite(reorder_timeout) && reorder_timeout >= 0,
@@ -163,9 +203,42 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Note("not empty");
   registry
       ->Add(key("pose_source"), &o->pose_source,
-            "tf: world_frame <- image frame_id at the image stamp; topic: "
-            "`pose` (PoseStamped)")
-      .OneOf({"tf", "topic"});
+            "tf: world_frame <- image frame_id at the image stamp; on `pose`, "
+            "interpolated at the image stamp: pose (PoseStamped; topic = the "
+            "same), pose_with_covariance, transform (TransformStamped), "
+            "odometry (nav_msgs/Odometry)")
+      .OneOf({"tf", "topic", "pose", "pose_with_covariance", "transform",
+              "odometry"});
+  registry
+      ->Add(key("pose_max_gap"), &o->pose_max_gap,
+            "s, topic poses are interpolated only between poses at most this "
+            "far apart")
+      .Min(0)
+      .Max(10);
+  registry
+      ->Add(key("pose_queue_size"), &o->pose_queue_size,
+            "roscpp queue of the pose subscription")
+      .Min(1)
+      .Max(10000);
+  registry
+      ->Add(key("image_queue_size"), &o->image_queue_size,
+            "roscpp queue of the image subscription (overflows counted)")
+      .Min(1)
+      .Max(10000);
+  registry
+      ->Add(key("camera_info_queue_size"), &o->camera_info_queue_size,
+            "roscpp queue of the camera_info subscription")
+      .Min(1)
+      .Max(10000);
+  registry->Add(key("pose_frame"), &o->pose_frame,
+                "frame the topic poses are of; \"\" = the camera (pose), the "
+                "child_frame_id (transform, odometry); a body frame needs "
+                "camera_extrinsic or tf body <- camera");
+  registry
+      ->Add(key("camera_extrinsic"), &o->camera_extrinsic,
+            "T_body_camera \"x y z qx qy qz qw\"; \"\" = from tf "
+            "(/tf_static)")
+      .Note("\"\" or 7 numbers");
   registry
       ->Add(key("tf_timeout"), &o->tf_timeout,
             "s to wait for the pose of a frame")
@@ -173,7 +246,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Max(60);
   registry
       ->Add(key("pose_sync_tolerance"), &o->pose_sync_tolerance,
-            "s, pose topic stamp match")
+            "s, a topic pose this close to the image stamp is used as is when "
+            "no two poses around the stamp can be interpolated")
       .Min(0);
   registry->Add(key("camera_frame"), &o->camera_frame,
                 "camera optical frame; \"\" = the image header's frame_id");
@@ -213,6 +287,11 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("error_throttle"), &o->error_throttle,
             "s between repeated errors about the same problem")
       .Min(0);
+  registry
+      ->Add(key("drop_window"), &o->drop_window,
+            "s, diagnostics WARN while drops happened within this window")
+      .Min(0.1)
+      .Max(86400);
   RegisterOptions(registry, prefix, &o->stream);
 }
 
@@ -266,6 +345,11 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("error_throttle"), &o->error_throttle,
             "s between repeated errors about the same problem")
       .Min(0);
+  registry
+      ->Add(key("drop_window"), &o->drop_window,
+            "s, diagnostics WARN while drops happened within this window")
+      .Min(0.1)
+      .Max(86400);
   // The core's fusion options, with the node's smaller memory budgets
   // (map_cache_mb 256, pending_mb 128; the CLI's are 512 and 256).
   RegisterOptions(registry, key("fusion"), &o->fusion);

@@ -66,6 +66,7 @@ FusionSession::FusionSession(const FusionSessionOptions& options,
       store_(options.map_store_mb, options.spill_dir),
       reorder_(options.reorder_timeout) {
   NewFusionLocked();
+  SnapshotLocked();
 }
 
 void FusionSession::NewFusionLocked() {
@@ -79,16 +80,19 @@ bool FusionSession::Add(FusionView view) {
   const uint64_t key = view.stamp_ns;
   if (view_of_stamp_.count(key) || reorder_.Contains(key)) {
     ++revisions_ignored_;  // fusion is incremental: first result stays
+    SnapshotLocked();
     return false;
   }
   reorder_.Insert(std::move(view));
   FuseReadyLocked();
+  SnapshotLocked();
   return true;
 }
 
 void FusionSession::FuseReady() {
   std::lock_guard<std::mutex> lock(mutex_);
   FuseReadyLocked();
+  SnapshotLocked();
 }
 
 void FusionSession::FuseReadyLocked() {
@@ -101,17 +105,23 @@ PointCloud FusionSession::FlushAndCloud() {
   std::lock_guard<std::mutex> lock(mutex_);
   // Views still waiting for an earlier keyframe are fused first.
   for (FusionView& view : reorder_.PopAll()) FuseLocked(std::move(view));
+  SnapshotLocked();
   return fusion_->Cloud();
 }
 
 bool FusionSession::CloudIfChanged(uint64_t* version, bool force,
                                    PointCloud* cloud,
                                    uint64_t* stamp_ns) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!force && *version == cloud_version_) return false;
-  *version = cloud_version_;
-  *cloud = fusion_->Cloud();
-  *stamp_ns = newest_stamp_ns_;
+  // From the snapshot: never waits for a view being fused.
+  std::shared_ptr<const PointCloud> snap;
+  {
+    std::lock_guard<std::mutex> lock(snapshot_mutex_);
+    if (!force && *version == snapshot_version_) return false;
+    *version = snapshot_version_;
+    *stamp_ns = snapshot_stamp_ns_;
+    snap = cloud_snapshot_;
+  }
+  *cloud = snap ? *snap : PointCloud();
   return true;
 }
 
@@ -120,6 +130,37 @@ void FusionSession::Reset() {
   ClearLocked();
   reorder_.Clear();
   ++resets_;
+  SnapshotLocked();
+}
+
+void FusionSession::SnapshotLocked() {
+  FusionSessionStats s;
+  s.waiting = reorder_.size();
+  s.fused = fused_;
+  s.revisions_ignored = revisions_ignored_;
+  s.spilled = store_.spilled();
+  s.resets = resets_;
+  s.sessions = sessions_;
+  s.session_saves = session_saves_;
+  s.held_mb = store_.bytes() / 1048576.0;
+  s.fusion = fusion_->stats();
+  s.fusion_bytes = fusion_->bytes();
+  s.last_fuse_seconds = last_fuse_seconds_;
+  std::shared_ptr<const PointCloud> cloud;
+  bool changed = false;
+  {
+    std::lock_guard<std::mutex> lock(snapshot_mutex_);
+    changed = snapshot_version_ != cloud_version_;
+  }
+  // The copy is made outside the snapshot lock (readers never wait for it).
+  if (changed) cloud = std::make_shared<const PointCloud>(fusion_->Cloud());
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  stats_snapshot_ = s;
+  if (changed) {
+    cloud_snapshot_ = std::move(cloud);
+    snapshot_version_ = cloud_version_;
+    snapshot_stamp_ns_ = newest_stamp_ns_;
+  }
 }
 
 void FusionSession::ClearLocked() {
@@ -196,20 +237,8 @@ void FusionSession::FuseLocked(FusionView item) {
 }
 
 FusionSessionStats FusionSession::Stats() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  FusionSessionStats s;
-  s.waiting = reorder_.size();
-  s.fused = fused_;
-  s.revisions_ignored = revisions_ignored_;
-  s.spilled = store_.spilled();
-  s.resets = resets_;
-  s.sessions = sessions_;
-  s.session_saves = session_saves_;
-  s.held_mb = store_.bytes() / 1048576.0;
-  s.fusion = fusion_->stats();
-  s.fusion_bytes = fusion_->bytes();
-  s.last_fuse_seconds = last_fuse_seconds_;
-  return s;
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  return stats_snapshot_;
 }
 
 }  // namespace wild_mvs

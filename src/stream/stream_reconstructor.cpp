@@ -114,18 +114,31 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
 StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     uint64_t stamp_ns, const std::string& frame_id, const Camera& camera,
     const cv::Mat& image) {
-  const double stamp = StampSeconds(stamp_ns);
+  // Checked before any state changes (the ImageFn path can only check the
+  // image once the frame is admitted).
   camera.Validate("frame '" + frame_id + "'");
   Require(image.type() == CV_32FC3, "frame '", frame_id,
           "': image must be CV_32FC3");
   Require(image.cols == camera.width && image.rows == camera.height, "frame '",
           frame_id, "': image is ", image.cols, "x", image.rows,
           " but its camera is ", camera.width, "x", camera.height);
+  return AddFrame(stamp_ns, frame_id, camera, [&image](Camera*, cv::Mat* out) {
+    *out = image;
+    return true;
+  });
+}
+
+StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
+    uint64_t stamp_ns, const std::string& frame_id, const Camera& pose_camera,
+    const ImageFn& make_image) {
+  const double stamp = StampSeconds(stamp_ns);
+  pose_camera.Validate("frame '" + frame_id + "'");
   Require(std::isfinite(stamp), "frame '", frame_id, "': stamp is not finite");
 
+  // 1. The stamp and the pose alone decide whether the frame is kept (no
+  // pixel has been touched yet).
   FrameStatus status = FrameStatus::kKeyframe;
-  KeyframePtr kf;
-  std::vector<KeyframePtr> evicted;
+  uint64_t generation = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.frames;
@@ -138,7 +151,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
         return FrameStatus::kOutOfOrder;
       }
     }
-    const Eigen::Vector3d center = camera.Center();
+    const Eigen::Vector3d center = pose_camera.Center();
     if (status != FrameStatus::kReset && have_last_center_ &&
         options_.max_pose_jump > 0 && stamp - last_stamp_ < 1.0 &&
         (center - last_center_).norm() > options_.max_pose_jump) {
@@ -152,9 +165,29 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
       session_ = stamp;
       session_ns_ = stamp_ns;
     }
-    if (!store_.IsNewKeyframe(camera, options_.keyframes))
+    if (!store_.IsNewKeyframe(pose_camera, options_.keyframes))
       return FrameStatus::kNotKeyframe;
+    generation = generation_;
+  }
 
+  // 2. Only a keyframe's image is converted (outside the lock).
+  Camera camera = pose_camera;
+  cv::Mat image;
+  if (!make_image(&camera, &image)) return FrameStatus::kDropped;
+  camera.Validate("frame '" + frame_id + "'");
+  Require(image.type() == CV_32FC3, "frame '", frame_id,
+          "': image must be CV_32FC3");
+  Require(image.cols == camera.width && image.rows == camera.height, "frame '",
+          frame_id, "': image is ", image.cols, "x", image.rows,
+          " but its camera is ", camera.width, "x", camera.height);
+
+  KeyframePtr kf;
+  std::vector<KeyframePtr> evicted;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Reset() while the image was converted: the frame belongs to the
+    // session that ended.
+    if (generation != generation_) return FrameStatus::kNotKeyframe;
     kf = std::make_shared<Keyframe>();
     kf->id = next_id_++;
     kf->stamp = stamp;
@@ -178,6 +211,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
       if (!e->done() && !in_flight_.count(e->id)) ++stats_.evicted_waiting;
     ++stats_.keyframes_total;
     last_keyframe_wall_ = WallSeconds();
+    idle_scheduled_ = false;
   }
 
   if (tracker_) {
@@ -198,6 +232,20 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
   std::lock_guard<std::mutex> lock(mutex_);
   ScheduleLocked();
   return status;
+}
+
+void StreamReconstructor::SetOptions(const StreamOptions& options) {
+  options.Check();
+  std::lock_guard<std::mutex> lock(mutex_);
+  options_.keyframes = options.keyframes;
+  options_.mvs = options.mvs;
+  // The new thresholds may make waiting keyframes ready.
+  ScheduleLocked();
+}
+
+StreamOptions StreamReconstructor::Options() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return options_;
 }
 
 bool StreamReconstructor::IsOutOfOrder(uint64_t stamp_ns) const {
@@ -294,9 +342,21 @@ StreamReconstructor::Neighborhood StreamReconstructor::Evaluate(
 void StreamReconstructor::ScheduleLocked() {
   ready_waiting_ = 0;
   if (stopping_ || store_.size() < 2) return;
+  const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
+  if (idle) idle_scheduled_ = true;
+  // The snapshot (every keyframe and sparse point) only when some keyframe
+  // could be scheduled.
+  auto schedulable = [this](const KeyframePtr& kf) {
+    if (!kf->owned || in_flight_.count(kf->id)) return false;
+    return kf->reconstructions == 0 ||
+           (options_.redo_min_gain > 0 &&
+            kf->reconstructions <= options_.max_redo);
+  };
+  const std::vector<KeyframePtr> all = store_.All();
+  if (std::none_of(all.begin(), all.end(), schedulable)) return;
+  ++stats_.scheduling_passes;
   const Snapshot snap = MakeSnapshotLocked();
   const uint32_t newest = store_.Newest()->id;
-  const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
   for (size_t i = 0; i < snap.keyframes.size(); ++i) {
     const KeyframePtr& kf = snap.keyframes[i];
     if (!kf->owned || in_flight_.count(kf->id)) continue;
@@ -330,7 +390,13 @@ void StreamReconstructor::ScheduleLocked() {
 
 void StreamReconstructor::Tick() {
   std::lock_guard<std::mutex> lock(mutex_);
+  // Every event (keyframe, sparse points, finished map, reset) schedules at
+  // once; the only thing time changes is the idle flush, done once per
+  // quiet spell.
+  const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
+  if (!idle || idle_scheduled_) return;
   ScheduleLocked();
+  idle_scheduled_ = true;
 }
 
 void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
@@ -339,6 +405,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   int ref = -1;
   double session = 0;
   uint64_t session_ns = 0;
+  MvsOptions mvs;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (stopping_ || generation != generation_) {
@@ -358,6 +425,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
     session = session_;
     session_ns = session_ns_;
+    mvs = options_.mvs;  // SetOptions may change it meanwhile
   }
   StreamResult result;
   result.keyframe_id = id;
@@ -374,9 +442,9 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     const std::vector<KeyframePtr>& kfs = snap.keyframes;
     ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
     ViewReport report;
-    result.depth =
-        ReconstructView(snap.scene, ref, cache, options_.mvs, inner_pool_.get(),
-                        &report, cv::Mat(), &snap.points_per_view);
+    result.depth = ReconstructView(snap.scene, ref, cache, mvs,
+                                   inner_pool_.get(), &report, cv::Mat(),
+                                   &snap.points_per_view);
     result.depth.view = static_cast<int>(id);
     result.depth.neighbors.clear();
     for (int n : report.neighbors) {

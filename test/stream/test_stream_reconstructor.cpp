@@ -208,6 +208,117 @@ TEST(StreamReconstructor, KeyframeSelectionOrderAndResets) {
   EXPECT_TRUE(c.results.empty());
 }
 
+// The keyframe test runs on the pose alone: the image of a frame that is not
+// kept is never made (the node decodes and undistorts only keyframes), and
+// a frame whose image cannot be made is dropped without becoming one.
+TEST(StreamReconstructor, OnlyKeyframeImagesAreMade) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.min_neighbors = 100;  // selection only
+  o.idle_flush = 1e6;
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  using S = StreamReconstructor::FrameStatus;
+  int made = 0;
+  auto image_of = [&](int i) {
+    return [&, i](Camera*, cv::Mat* image) {
+      ++made;
+      *image = s.images[i];
+      return true;
+    };
+  };
+  const uint64_t t0 = 1795000000000000000ull;  // epoch stamps (ns)
+  const uint64_t dt = 33333333ull;             // 30 Hz
+  // Frame 0, then 9 frames at the same pose (a robot standing still),
+  // then frame 1's pose.
+  EXPECT_EQ(stream.AddFrame(t0, "cam", s.scene.views[0].camera, image_of(0)),
+            S::kKeyframe);
+  for (int k = 1; k < 10; ++k)
+    EXPECT_EQ(stream.AddFrame(t0 + k * dt, "cam", s.scene.views[0].camera,
+                              image_of(0)),
+              S::kNotKeyframe);
+  EXPECT_EQ(made, 1);
+  // A keyframe whose image fails: dropped, not kept.
+  EXPECT_EQ(stream.AddFrame(t0 + 10 * dt, "cam", s.scene.views[1].camera,
+                            [&](Camera*, cv::Mat*) { return false; }),
+            S::kDropped);
+  EXPECT_EQ(stream.Stats().keyframes, 1u);
+  // The image function may change the intrinsics (undistortion): the
+  // keyframe keeps the camera it returns.
+  Camera undistorted;
+  EXPECT_EQ(stream.AddFrame(t0 + 11 * dt, "cam", s.scene.views[1].camera,
+                            [&](Camera* cam, cv::Mat* image) {
+                              cam->fx *= 1.01;
+                              undistorted = *cam;
+                              *image = s.images[1];
+                              return true;
+                            }),
+            S::kKeyframe);
+  EXPECT_EQ(stream.Stats().keyframes, 2u);
+  EXPECT_EQ(stream.Stats().frames, 12u);
+  EXPECT_DOUBLE_EQ(undistorted.fx, s.scene.views[1].camera.fx * 1.01);
+}
+
+// Tick() is cheap when nothing changed: no scheduling pass (store snapshot
+// and view selection) until a keyframe, points or a finished map arrive,
+// and one idle flush per quiet spell.
+TEST(StreamReconstructor, TickSchedulesOnlyWhenSomethingChanged) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.min_neighbors = 100;  // keyframes never ready: they stay schedulable
+  o.idle_flush = 0.05;
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  for (int i = 0; i < 3; ++i)
+    stream.AddFrame(double(i), "cam", s.scene.views[i].camera, s.images[i]);
+  const uint64_t after_frames = stream.Stats().scheduling_passes;
+  EXPECT_GE(after_frames, 2u);  // the 2nd and 3rd keyframe scheduled
+  // Wait for the quiet spell: the first Tick then flushes once.
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (int k = 0; k < 100; ++k) stream.Tick();
+  EXPECT_EQ(stream.Stats().scheduling_passes, after_frames + 1);
+  // New points: scheduled at once (not by a Tick).
+  stream.SetSparsePoints(StampedPoints(s));
+  EXPECT_EQ(stream.Stats().scheduling_passes, after_frames + 2);
+  for (int k = 0; k < 100; ++k) stream.Tick();
+  EXPECT_EQ(stream.Stats().scheduling_passes, after_frames + 2);
+}
+
+// Live tuning: new keyframe thresholds change the selection from the next
+// frame on; invalid options are refused and the old ones kept.
+TEST(StreamReconstructor, SetOptionsRetunesKeyframeSelectionLive) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.min_neighbors = 100;  // selection only
+  o.idle_flush = 1e6;
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  using S = StreamReconstructor::FrameStatus;
+  EXPECT_EQ(stream.AddFrame(0.0, "cam", s.scene.views[0].camera, s.images[0]),
+            S::kKeyframe);
+  // Views are 10 degrees (0.45 m) apart: with 100 m and 90 degrees no frame
+  // is a keyframe any more.
+  StreamOptions strict = stream.Options();
+  strict.keyframes.min_baseline = 100;
+  strict.keyframes.min_angle_deg = 90;
+  stream.SetOptions(strict);
+  EXPECT_EQ(stream.AddFrame(1.0, "cam", s.scene.views[1].camera, s.images[1]),
+            S::kNotKeyframe);
+  // Invalid: refused, the strict thresholds stay.
+  StreamOptions bad = strict;
+  bad.mvs.mpgc.window = 4;  // must be odd
+  EXPECT_THROW(stream.SetOptions(bad), Error);
+  EXPECT_EQ(stream.Options().mvs.mpgc.window, strict.mvs.mpgc.window);
+  EXPECT_EQ(stream.AddFrame(2.0, "cam", s.scene.views[2].camera, s.images[2]),
+            S::kNotKeyframe);
+  // Back to the defaults: the next view is a keyframe again.
+  stream.SetOptions(o);
+  EXPECT_EQ(stream.AddFrame(3.0, "cam", s.scene.views[3].camera, s.images[3]),
+            S::kKeyframe);
+}
+
 TEST(StreamReconstructor, StoreStaysBoundedOnALongStream) {
   const SyntheticScene& s = Scene6();
   StreamOptions o = FastOptions();

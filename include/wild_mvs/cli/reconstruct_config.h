@@ -35,7 +35,9 @@ namespace cli {
 struct RunOptions {
   // Worker threads; 0 = one per core. Results do not depend on it.
   int threads = 0;
-  // Stages of `reconstruct`, comma-separated subset of depth,fuse,mesh.
+  // Stages of `reconstruct`, comma-separated subset of sparse,depth,fuse,mesh.
+  // "depth" computes the sparse tracks itself when the dataset has none;
+  // "sparse" alone computes only them (OUT/sparse), e.g. before --shard runs.
   std::string stages = "depth,fuse,mesh";
   void Check() const;
   bool HasStage(const std::string& stage) const;

@@ -38,6 +38,10 @@ struct DepthStageResult {
   // The geometric-consistency filter of the views computed in this run:
   // samples before and kept.
   long long consistency_samples = 0, consistency_kept = 0;
+  // Views whose MVS map is in OUT/raw, to be filtered later (filter_now
+  // false: a --shard process; `wild_mvs fuse` filters them). They count in
+  // computed / skipped, and samples are then before the filter.
+  int unfiltered = 0;
   double seconds = 0;
   std::vector<std::string> failures;  // "view: problem"
 };
@@ -47,13 +51,14 @@ bool ViewOutputsComplete(const std::string& out, const std::string& stem);
 // Depth maps of `views` (in order): skips complete views unless `force`,
 // writes depth/normal/confidence/cameras/preview files and log/S.json. A
 // view that fails (bad image, ...) is reported in `failures` and the others
-// go on; output write errors abort (Error).
-DepthStageResult RunDepthStage(const Scene& scene,
-                               const std::vector<int>& views,
-                               ImageCache& images,
-                               const ReconstructConfig& config,
-                               ThreadPool* pool, const std::string& out,
-                               bool force, std::ostream& log);
+// go on; output write errors abort (Error). With the consistency filter
+// (mvs.consistency.enabled) the MVS maps go to OUT/raw and, when
+// `filter_now`, are filtered into OUT at the end; otherwise (a shard, which
+// lacks its neighbours' maps) they stay in OUT/raw for FilterPendingViews.
+DepthStageResult RunDepthStage(
+    const Scene& scene, const std::vector<int>& views, ImageCache& images,
+    const ReconstructConfig& config, ThreadPool* pool, const std::string& out,
+    bool force, std::ostream& log, bool filter_now = true);
 
 struct FilterStageResult {
   int filtered = 0;
@@ -71,6 +76,35 @@ FilterStageResult FilterDepthMaps(const Scene& scene,
                                   const std::string& raw,
                                   const std::string& out, ThreadPool* pool,
                                   std::ostream& log);
+
+// The views of `scene` with a complete raw map in OUT/raw but no complete
+// final map in OUT (left by --shard runs), filtered with FilterDepthMaps
+// from OUT/raw into OUT; nothing when the filter is disabled. Throws Error
+// listing the views that failed.
+FilterStageResult FilterPendingViews(const Scene& scene,
+                                     const GeometricConsistencyOptions& options,
+                                     const std::string& out, ThreadPool* pool,
+                                     std::ostream& log);
+
+// The sparse tracks of a dataset without sparse points, shared by the runs
+// on one OUT: OUT/sparse/tracks.txt (io/sparse_tracks_file.h; the COLMAP
+// text model beside it). `fingerprint`: "KEY VALUE" of the options the
+// tracks depend on (TracksFingerprint).
+std::string SparseTracksPath(const std::string& out);
+std::vector<std::string> TracksFingerprint(const OptionSet& options,
+                                           const std::string& mask_dir);
+// Loads the tracks of an earlier run on `out` into scene->points when they
+// were computed for these views and options; returns false (saying why on
+// `log` when a file was there) otherwise.
+bool LoadSceneTracks(Scene* scene, const std::string& out,
+                     const std::vector<std::string>& fingerprint,
+                     std::ostream& log);
+// ComputeSceneTracks, then writes OUT/sparse (COLMAP text) and the exact
+// record OUT/sparse/tracks.txt, each atomically.
+SparseSummary ComputeAndSaveSceneTracks(
+    Scene* scene, const ReconstructConfig& config, ThreadPool* pool,
+    const std::string& out, const std::vector<std::string>& fingerprint,
+    std::ostream& log);
 
 struct FuseResult {
   int views = 0;

@@ -30,5 +30,18 @@ int LimitImageSize(Scene* scene, int max_size);
 // stems); "" = all views. Throws UsageError naming an unknown entry.
 std::vector<int> SelectViews(const Scene& scene, const std::string& list);
 
+// `--shard K/N`: share K (1..N) of N independent processes.
+struct Shard {
+  int index = 1, count = 1;  // K, N; 1/1 = the whole list
+  bool IsWhole() const { return count == 1; }
+};
+// Parses "K/N" (1 <= K <= N). Throws UsageError naming --shard.
+Shard ParseShard(const std::string& text);
+// The views of shard K/N: `views` sorted by scene index, then every N-th
+// from position K-1 (round robin: neighbouring views, which cost about the
+// same, go to different shards). A function of the view list only, so every
+// process computes the same split.
+std::vector<int> ShardViews(std::vector<int> views, const Shard& shard);
+
 }  // namespace cli
 }  // namespace wild_mvs

@@ -17,7 +17,23 @@ namespace wild_mvs {
 // (View::file_width/height, else the camera's), resizes it to the camera
 // (area averaging) and converts it with ToLinearRgb. Throws Error naming
 // the file and the problem (missing, unreadable, wrong size).
+// A JPEG at least twice the camera's size (a downscaled view, e.g. a 24 MP
+// photo and --max-image-size 2000) is decoded reduced by libjpeg
+// (JpegReductionFactor), then resized by the exact remaining factor, so the
+// camera stays exact.
 cv::Mat LoadViewImage(const View& view, const ImageOptions& options);
+
+// The reduction factor of the JPEG decode of a file_width x file_height
+// image for a camera of width x height: the largest of 8, 4, 2 with
+// file size >= factor x camera size on both axes (the decoded image,
+// ceil(file size / factor), holds at least the camera's resolution), else 1.
+int JpegReductionFactor(int file_width, int file_height, int width, int height);
+
+// The view's image file as decoded, before undistortion and resizing: a JPEG
+// decoded at 1/factor (ceil(file size / factor) pixels) when
+// JpegReductionFactor allows it, else the full file (checked against the
+// size the view expects); *factor (optional) receives the factor used.
+cv::Mat ReadViewImageFile(const View& view, int* factor);
 
 // An ImageCache loader that reads the views of `scene` (which must outlive
 // it) with LoadViewImage.

@@ -27,6 +27,7 @@
 #include <visualization_msgs/Marker.h>
 #include <wild_mvs/DepthView.h>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -81,6 +82,11 @@ sensor_msgs::CameraInfo CameraInfoFromCamera(const Camera& camera);
 void SetCameraPose(const geometry_msgs::Transform& world_T_camera,
                    Camera* camera);
 void SetCameraPose(const geometry_msgs::Pose& world_T_camera, Camera* camera);
+void SetCameraPose(const Eigen::Isometry3d& world_T_camera, Camera* camera);
+// A pose or transform message as a rigid transform, checked like
+// SetCameraPose (throws Error naming the problem).
+Eigen::Isometry3d IsometryFromMsg(const geometry_msgs::Pose& pose);
+Eigen::Isometry3d IsometryFromMsg(const geometry_msgs::Transform& transform);
 // The camera's pose in the world (inverse of the core's world-to-camera).
 geometry_msgs::Pose PoseFromCamera(const Camera& camera);
 

@@ -8,7 +8,10 @@
 #pragma once
 
 #include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <geometry_msgs/TransformStamped.h>
 #include <image_transport/image_transport.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/node_handle.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -17,8 +20,10 @@
 #include <tf2_ros/transform_listener.h>
 #include <wild_mvs/SparsePoints.h>
 
+#include <Eigen/Geometry>
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
@@ -29,6 +34,7 @@
 #include "wild_mvs/core/camera.h"
 #include "wild_mvs/ros/params.h"
 #include "wild_mvs/ros/undistorter.h"
+#include "wild_mvs/stream/pose_track.h"
 #include "wild_mvs/stream/stamp_buffer.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
 
@@ -68,13 +74,22 @@ class DepthInputs {
   // camera_info of the frame's stamp (or the latest): false when none came
   // within tf_timeout.
   bool PairCameraInfo(DepthFrame* f);
-  // Camera (intrinsics and pose) and undistorted linear RGB image of a
-  // paired frame; false when the frame is dropped.
-  bool Convert(const DepthFrame& f, Camera* cam, cv::Mat* image);
+  // The three steps of a paired frame, each false when the frame is
+  // dropped (counted): the camera's intrinsics from its camera_info; its
+  // pose (tf, or the pose topic interpolated at the stamp, with the body
+  // extrinsic); and, only for a frame kept as a keyframe, the image
+  // decoded to linear RGB and undistorted (which may change the camera's
+  // intrinsics).
+  bool CameraFromInfo(const DepthFrame& f, Camera* cam);
+  bool LookupPose(const DepthFrame& f, Camera* cam);
+  bool ConvertImage(const DepthFrame& f, Camera* cam, cv::Mat* image);
 
   // The topic a frame came on (for messages) and the resolved inputs.
   std::string ImageTopic(const DepthFrame& f) const;
   std::string Topic(const std::string& name) const;
+  // The subscribed topics (resolved) and the parameters of their roscpp
+  // queue sizes.
+  std::map<std::string, std::string> QueueParams() const;
   const std::string& image_topic() const { return image_topic_; }
   const std::string& info_topic() const { return info_topic_; }
   bool rectified() const { return rectified_; }
@@ -83,11 +98,22 @@ class DepthInputs {
   std::string NoSlash(const std::string& frame_id);
 
  private:
-  bool LookupPose(const DepthFrame& f, Camera* cam);
+  // The pose topic's messages, by type (pose_source).
+  void OnPoseStamped(const geometry_msgs::PoseStampedConstPtr& msg);
+  void OnPoseWithCovariance(
+      const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
+  void OnTransform(const geometry_msgs::TransformStampedConstPtr& msg);
+  void OnOdometry(const nav_msgs::OdometryConstPtr& msg);
+  // One pose message: world frame checked, the pose kept by its stamp.
+  // `child` is the frame it is the pose of ("" = the camera).
+  void AddPose(const std_msgs::Header& header, const std::string& child,
+               const geometry_msgs::Pose& pose);
+  // T_body_camera: ~camera_extrinsic, else tf (latest) body <- camera.
+  bool BodyToCamera(const std::string& body, const std::string& camera,
+                    Eigen::Isometry3d* T);
   void OnRaw(const sensor_msgs::ImageConstPtr& msg);
   void OnCompressed(const sensor_msgs::CompressedImageConstPtr& msg);
   void OnInfo(const sensor_msgs::CameraInfoConstPtr& msg);
-  void OnPose(const geometry_msgs::PoseStampedConstPtr& msg);
   void OnSparsePoints(const wild_mvs::SparsePointsConstPtr& msg);
 
   ros::NodeHandle nh_, pnh_;
@@ -105,7 +131,14 @@ class DepthInputs {
   ros::Subscriber compressed_sub_, info_sub_, pose_sub_, points_sub_;
   // camera_infos by exact stamp (ns) and poses of the pose topic.
   ExactStampBuffer<sensor_msgs::CameraInfoConstPtr> infos_{100};
-  NearestStampBuffer<geometry_msgs::PoseStampedConstPtr> poses_{500};
+  // Poses of the pose topic (frame-to-world) and the frame they are of
+  // (the messages' child_frame_id or ~pose_frame; "" = the camera).
+  PoseTrack poses_{2000};
+  std::mutex pose_frame_mutex_;
+  std::string pose_frame_;
+  // ~camera_extrinsic, parsed (when set).
+  bool have_extrinsic_ = false;
+  Eigen::Isometry3d body_T_camera_ = Eigen::Isometry3d::Identity();
   std::atomic<bool> stopping_{false};
   std::mutex slash_mutex_;
   std::set<std::string> slash_warned_;  // frame ids warned about once

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <diagnostic_updater/update_functions.h>
 #include <image_transport/image_transport.h>
 #include <ros/node_handle.h>
 #include <ros/publisher.h>
@@ -13,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "wild_mvs/stream/drop_counter.h"
@@ -52,10 +54,28 @@ std::vector<StreamReconstructor::StampedPoint> StampedPointsFromMsg(
 
 // The depth node's diagnostics: the stream's statistics, the input queue
 // and the drops by reason.
+// A diagnostic_updater::FrequencyStatus (the event rate over the last
+// `window` diagnostics updates, judged against [min_hz, max_hz]; 0 and inf
+// = not judged) that reports a window without events as `quiet_level` with
+// `quiet_message` instead of ERROR: no depth map for a while is normal when
+// no new keyframe came.
+class RateStatus : private std::pair<double, double>,
+                   public diagnostic_updater::FrequencyStatus {
+ public:
+  RateStatus(const std::string& name, double min_hz, double max_hz, int window,
+             unsigned char quiet_level, std::string quiet_message);
+  void run(diagnostic_updater::DiagnosticStatusWrapper& stat) override;
+
+ private:
+  unsigned char quiet_level_;
+  std::string quiet_message_;
+};
+
 struct DepthInputStats {
-  uint64_t received = 0;  // frames received
-  size_t queued = 0;      // input queue length
-  int queue_size = 0;     // its bound
+  uint64_t received = 0;          // frames received
+  size_t queued = 0;              // input queue length
+  int queue_size = 0;             // its bound
+  uint64_t recent_evictions = 0;  // within the drop counter's window
 };
 void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
                           const DropCounter& drops,

@@ -7,7 +7,10 @@
 //        camera_info (beside the image, image_transport's CameraSubscriber
 //        convention, unless `camera_info` itself is remapped; paired with
 //        the image by exact stamp, or the latest with ~camera_info_latest),
-//        pose (geometry_msgs/PoseStamped, ~pose_source:=topic),
+//        pose (~pose_source: pose = topic (PoseStamped),
+//        pose_with_covariance, transform (TransformStamped) or odometry
+//        (nav_msgs/Odometry), of the camera or of a body frame with the
+//        camera extrinsic; interpolated at the image stamp),
 //        sparse_points (wild_mvs/SparsePoints, ~sparse_source:=topic)
 //   out (private, ~name), each with the source image's header (stamp bit
 //        for bit, frame = the camera optical frame):
@@ -25,7 +28,9 @@
 // timers. Parameters: config/depth_node.yaml.
 //
 // Callbacks only queue messages (bounded; the oldest is dropped and counted
-// when full). A front-end thread converts, looks up the pose and feeds the
+// when full). A front-end thread looks up the pose, lets the
+// StreamReconstructor's keyframe test decide on it, converts (decodes,
+// undistorts) only the keyframes' images and feeds them to the
 // StreamReconstructor, whose worker thread reconstructs keyframes. Bad input
 // is dropped with a throttled ROS_ERROR naming the topic and the problem and
 // counted by reason in the diagnostics.

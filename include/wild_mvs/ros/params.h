@@ -18,6 +18,7 @@
 // ros::NodeHandle.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <map>
 #include <string>
 #include <variant>
@@ -75,11 +76,33 @@ std::vector<std::string> UnknownParams(const ParamSource& params,
 // reconstructor's and the core's options).
 struct DepthNodeOptions {
   std::string world_frame = "world";  // fixed frame of the poses (REP 105)
-  // "tf": pose = tf2 lookup world_frame <- image frame_id at the image stamp;
-  // "topic": geometry_msgs/PoseStamped on `pose`, matched by stamp.
+  // Where the camera's pose comes from:
+  //   "tf": tf2 lookup world_frame <- image frame_id at the image stamp;
+  //   on the `pose` topic, in world_frame: "pose" (geometry_msgs/
+  //   PoseStamped; "topic" is the same), "pose_with_covariance"
+  //   (PoseWithCovarianceStamped), "transform" (TransformStamped) or
+  //   "odometry" (nav_msgs/Odometry). Topic poses are interpolated at the
+  //   image stamp (slerp + lerp between the poses around it).
   std::string pose_source = "tf";
-  double tf_timeout = 0.2;            // s to wait for tf / a pose
-  double pose_sync_tolerance = 0.01;  // s, pose topic stamp match
+  double tf_timeout = 0.2;  // s to wait for tf / a pose
+  // s: a topic pose this close to the image stamp is used as is when no
+  // two poses around the stamp can be interpolated (e.g. the last pose).
+  double pose_sync_tolerance = 0.01;
+  double pose_max_gap = 0.2;  // s: interpolate only between poses at most
+                              // this far apart (refused beyond)
+  int pose_queue_size = 100;  // roscpp queue of the pose subscription
+  // roscpp queues of the image and camera_info subscriptions (their
+  // overflows are counted too, from roscpp's bus statistics).
+  int image_queue_size = 5;
+  int camera_info_queue_size = 20;
+  // The frame the topic's poses are of: "" = the camera optical frame for
+  // pose / pose_with_covariance, the messages' child_frame_id for
+  // transform / odometry. When it is not the camera frame (a robot body),
+  // T_world_camera = T_world_body * T_body_camera with the extrinsic below.
+  std::string pose_frame;
+  // T_body_camera as "x y z qx qy qz qw" (the camera optical frame in the
+  // body frame); "" = looked up in tf (/tf_static) body <- camera frame.
+  std::string camera_extrinsic;
   // Camera optical frame of the images; "" = the image header's frame_id.
   // Set it when a driver stamps images with another frame (e.g. a body or
   // link frame); tf must give world_frame <- camera_frame.
@@ -111,9 +134,16 @@ struct DepthNodeOptions {
   // Stamps of frames whose images are wrongly encoded etc. are dropped with
   // a ROS_ERROR at most every error_throttle seconds per kind of problem.
   double error_throttle = 5.0;
+  // Diagnostics WARN while there were drops within the last drop_window s
+  // (the totals are kept too).
+  double drop_window = 60.0;
   StreamOptions stream;  // keyframes, store, scheduling, core options
   void Check() const;
 };
+
+// ~camera_extrinsic "x y z qx qy qz qw" as T_body_camera; throws Error
+// naming the parameter when it is not 7 numbers or q is not a rotation.
+Eigen::Isometry3d ParseCameraExtrinsic(const std::string& text);
 
 struct FusionNodeOptions {
   std::string world_frame = "world";
@@ -123,6 +153,7 @@ struct FusionNodeOptions {
   int input_queue_size = 10;    // depth views waiting to be fused
   double diagnostics_period = 1.0;
   double error_throttle = 5.0;
+  double drop_window = 60.0;  // s, see DepthNodeOptions
   // Cloud published for rviz: at most this many points (uniform subsample);
   // the saved PLY always has all points. 0 = no limit.
   int max_published_points = 500000;

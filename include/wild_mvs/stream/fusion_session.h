@@ -127,11 +127,13 @@ class FusionSession {
   // Fuses every waiting view, ready or not, and returns the cloud (saves).
   PointCloud FlushAndCloud();
   // The cloud and the newest fused view's stamp when the cloud changed
-  // since *version (or `force`); updates *version (start at 0).
+  // since *version (or `force`); updates *version (start at 0). A snapshot
+  // as of the last fused view: never waits for a view being fused.
   bool CloudIfChanged(uint64_t* version, bool force, PointCloud* cloud,
                       uint64_t* stamp_ns) const;
   // Forgets the cloud, the fused and the waiting views.
   void Reset();
+  // As of the last change (never waits for a view being fused).
   FusionSessionStats Stats() const;
 
  private:
@@ -144,7 +146,16 @@ class FusionSession {
   const FusionSessionOptions options_;
   const DropCallback on_drop_;
   const LogCallback on_log_;
+  // Refreshes the snapshots below (end of every change, under mutex_).
+  void SnapshotLocked();
   mutable std::mutex mutex_;
+  // What readers get without waiting for mutex_ (held while a view is
+  // fused or a spilled map is read): the stats and the cloud as of the
+  // last change. Lock order: mutex_, then snapshot_mutex_.
+  mutable std::mutex snapshot_mutex_;
+  FusionSessionStats stats_snapshot_;
+  std::shared_ptr<const PointCloud> cloud_snapshot_;
+  uint64_t snapshot_version_ = 0, snapshot_stamp_ns_ = 0;
   DepthMapStore store_;
   ReorderBuffer reorder_;
   std::unique_ptr<StreamingFusion> fusion_;

@@ -118,6 +118,9 @@ struct StreamStats {
   uint64_t stale_results = 0;    // results discarded after a Reset
   uint64_t out_of_order = 0;     // frames with non-increasing stamps
   uint64_t resets = 0;
+  // Scheduling passes that evaluated the keyframes' neighbourhoods (a
+  // snapshot of the store each): only when something changed.
+  uint64_t scheduling_passes = 0;
   double session = -1;  // stamp that started the current session (-1: none)
   size_t sparse_points = 0;
   // Memory of the online tracker (SparseTracker::bytes()): it keeps a few
@@ -140,7 +143,12 @@ class StreamReconstructor {
     kNotKeyframe,  // too close to the last keyframe
     kOutOfOrder,   // stamp not after the previous frame's: dropped
     kReset,        // pose or time jump: the stream restarted with it
+    kDropped,      // a keyframe whose image the ImageFn could not make
   };
+  // Makes a kept frame's image: sets *image (CV_32FC3 linear RGB of the
+  // camera's size) and may change the camera's intrinsics (undistortion);
+  // false drops the frame (the function reports why).
+  using ImageFn = std::function<bool(Camera* camera, cv::Mat* image)>;
   // A new frame: camera (pose + intrinsics of `image`) and image (CV_32FC3
   // linear RGB of the camera's size). Call from one thread at a time (the
   // node's front end): the tracker runs here. A stamp more than
@@ -151,9 +159,21 @@ class StreamReconstructor {
   // results carry it unchanged.
   FrameStatus AddFrame(uint64_t stamp_ns, const std::string& frame_id,
                        const Camera& camera, const cv::Mat& image);
+  // The same, deciding on the stamp and the pose first: `make_image` is
+  // called (without a lock held) only for a frame kept as a keyframe, so
+  // that the frames in between are never decoded or undistorted.
+  // `pose_camera` needs only its pose for that decision.
+  FrameStatus AddFrame(uint64_t stamp_ns, const std::string& frame_id,
+                       const Camera& pose_camera, const ImageFn& make_image);
   // The same with a stamp in seconds (rounded to ns; tests and tools).
   FrameStatus AddFrame(double stamp, const std::string& frame_id,
                        const Camera& camera, const cv::Mat& image);
+  // Live tuning: takes the keyframe selection (keyframes) and the MVS
+  // options (mvs) of `options` (the other fields need a restart and are
+  // ignored). Throws Error (Check()) and keeps the old ones when invalid.
+  // Keyframes reconstructed from now on use them.
+  void SetOptions(const StreamOptions& options);
+  StreamOptions Options() const;
   // True when AddFrame would return kOutOfOrder for a frame with this stamp
   // (the node drops such frames before converting them).
   bool IsOutOfOrder(uint64_t stamp_ns) const;
@@ -168,7 +188,8 @@ class StreamReconstructor {
     std::vector<StampedObservation> observations;
   };
   void SetSparsePoints(const std::vector<StampedPoint>& points);
-  // Call periodically: flushes keyframes waiting longer than idle_flush.
+  // Call periodically: flushes keyframes waiting longer than idle_flush
+  // (cheap when nothing changed: no snapshot, no view selection).
   void Tick();
   // Forgets every keyframe and track (results of running reconstructions
   // are discarded).
@@ -213,6 +234,7 @@ class StreamReconstructor {
   int ready_waiting_ = 0;
   uint32_t next_id_ = 0;
   uint64_t generation_ = 0;
+  bool idle_scheduled_ = false;    // the idle flush ran since the last keyframe
   double last_keyframe_wall_ = 0;  // steady clock, s
   double last_stamp_ = -1;
   double session_ = -1;  // see StreamResult::session

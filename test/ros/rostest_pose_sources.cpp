@@ -1,0 +1,266 @@
+// Copyright wild_mvs authors. rostest (test/ros/pose_sources.test): camera
+// poses from the localisation sources robots have, published the way they
+// publish them: a body frame (base_link) moving continuously, its pose at
+// 100 Hz at stamps that are never the image stamps, the camera extrinsic on
+// /tf_static or as a parameter, a world frame named 'odom', epoch stamps.
+// Three depth nodes (Odometry, TransformStamped, PoseWithCovarianceStamped
+// of the camera) must each put every keyframe at the camera's true pose:
+// the pose interpolated at the image stamp (a nearest pose would be 5 mm
+// off at this speed) composed with the extrinsic.
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/image_encodings.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <wild_mvs/DepthView.h>
+
+#include <Eigen/SVD>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <mutex>
+
+#include "ros_test_scene.h"
+#include "rostest_util.h"
+#include "wild_mvs/core/metrics.h"
+#include "wild_mvs/ros/conversions.h"
+#include "wild_mvs/ros/scene_bag.h"
+
+namespace wild_mvs {
+namespace testing {
+namespace {
+
+constexpr int kViews = 5;
+constexpr double kFramePeriod = 0.25;  // s between images (stream time)
+constexpr double kPosePeriod = 0.01;   // 100 Hz poses
+constexpr double kPoseOffset = 0.003;  // pose stamps are not image stamps
+constexpr double kT0 = 1795000000.0;   // epoch stamp of the first image
+constexpr double kSlowdown = 2.0;      // wall seconds per stream second
+
+// T^s of a rigid motion T (screw interpolation): the continuous motion
+// that passes through identity at s = 0 and T at s = 1.
+Eigen::Isometry3d ScrewPower(const Eigen::Isometry3d& T, double s) {
+  const Eigen::AngleAxisd aa(T.linear());
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  if (std::abs(aa.angle()) < 1e-12) {
+    out.translation() = s * T.translation();
+    return out;
+  }
+  const Eigen::Vector3d a = aa.axis(), t = T.translation();
+  const double d = a.dot(t);  // slide along the axis
+  // A point p on the axis: (I - R) p = t - d a.
+  const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() - T.linear();
+  const Eigen::Vector3d p =
+      A.jacobiSvd(Eigen::ComputeFullU | Eigen::ComputeFullV).solve(t - d * a);
+  const Eigen::Matrix3d Rs =
+      Eigen::AngleAxisd(s * aa.angle(), a).toRotationMatrix();
+  out.linear() = Rs;
+  out.translation() = (Eigen::Matrix3d::Identity() - Rs) * p + s * d * a;
+  return out;
+}
+
+Eigen::Isometry3d WorldFromCamera(const Camera& cam) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = cam.R.transpose();
+  T.translation() = cam.Center();
+  return T;
+}
+
+// The camera's true pose at stream time t (s after kT0): the screw motion
+// between consecutive views, through every view at its image stamp.
+Eigen::Isometry3d CameraAt(const SyntheticScene& s, double t) {
+  const int n = static_cast<int>(s.scene.views.size());
+  int i = static_cast<int>(std::floor(t / kFramePeriod));
+  i = std::max(0, std::min(n - 2, i));
+  const Eigen::Isometry3d Ti = WorldFromCamera(s.scene.views[i].camera);
+  const Eigen::Isometry3d Tj = WorldFromCamera(s.scene.views[i + 1].camera);
+  const double u = t / kFramePeriod - i;  // may leave [0, 1] at the ends
+  return ScrewPower(Tj * Ti.inverse(), u) * Ti;
+}
+
+geometry_msgs::Pose PoseMsg(const Eigen::Isometry3d& T) {
+  geometry_msgs::Pose p;
+  const Eigen::Quaterniond q(T.linear());
+  p.position.x = T.translation().x();
+  p.position.y = T.translation().y();
+  p.position.z = T.translation().z();
+  p.orientation.x = q.x();
+  p.orientation.y = q.y();
+  p.orientation.z = q.z();
+  p.orientation.w = q.w();
+  return p;
+}
+
+TEST(PoseSources, OdometryTransformAndPoseWithCovarianceAreInterpolated) {
+  ros::NodeHandle nh;
+  const SyntheticScene scene = Render(RosTestSpec(kViews));
+  // The camera optical frame in base_link: REP 103 optical axes (z forward
+  // = body x) and an offset; the same as ~camera_extrinsic in the launch.
+  Eigen::Isometry3d body_T_cam = Eigen::Isometry3d::Identity();
+  body_T_cam.linear() =
+      Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5).toRotationMatrix();
+  body_T_cam.translation() = Eigen::Vector3d(0.12, -0.03, 0.25);
+  const Eigen::Isometry3d cam_T_body = body_T_cam.inverse();
+
+  tf2_ros::StaticTransformBroadcaster static_tf;
+  geometry_msgs::TransformStamped ext;
+  ext.header.stamp = ros::Time(kT0 - 10);
+  ext.header.frame_id = "base_link";
+  ext.child_frame_id = "camera_optical_frame";
+  {
+    const geometry_msgs::Pose p = PoseMsg(body_T_cam);
+    ext.transform.translation.x = p.position.x;
+    ext.transform.translation.y = p.position.y;
+    ext.transform.translation.z = p.position.z;
+    ext.transform.rotation = p.orientation;
+  }
+  static_tf.sendTransform(ext);
+
+  ros::Publisher odom_pub = nh.advertise<nav_msgs::Odometry>("/odometry", 200);
+  ros::Publisher tf_pub =
+      nh.advertise<geometry_msgs::TransformStamped>("/body_transform", 200);
+  ros::Publisher pwc_pub =
+      nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/camera_pose_cov",
+                                                             200);
+  ros::Publisher image_pub =
+      nh.advertise<sensor_msgs::Image>("/camera/image_raw", 10);
+  ros::Publisher info_pub =
+      nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 10);
+
+  const std::vector<std::string> nodes = {"odom", "tfmsg", "pwc"};
+  std::mutex mutex;
+  std::map<std::string, std::map<int, wild_mvs::DepthViewConstPtr>> views;
+  std::vector<ros::Subscriber> subs;
+  for (const std::string& node : nodes) {
+    subs.push_back(nh.subscribe<wild_mvs::DepthView>(
+        "/" + node + "/depth_view", 20,
+        [&, node](const wild_mvs::DepthViewConstPtr& m) {
+          const int i = static_cast<int>(
+              std::lround((m->header.stamp.toSec() - kT0) / kFramePeriod));
+          std::lock_guard<std::mutex> lock(mutex);
+          views[node][i] = m;
+        }));
+  }
+  DiagnosticsWatch diag(nh);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        for (const auto& s : subs)
+          if (s.getNumPublishers() == 0) return false;
+        return image_pub.getNumSubscribers() >= 3 &&
+               info_pub.getNumSubscribers() >= 3 &&
+               odom_pub.getNumSubscribers() >= 1 &&
+               tf_pub.getNumSubscribers() >= 1 &&
+               pwc_pub.getNumSubscribers() >= 1;
+      },
+      60));
+
+  // The stream in stamp order: poses from 0.1 s before the first image to
+  // 0.1 s after the last, images at their stamps.
+  const double t_end = (kViews - 1) * kFramePeriod + 0.1;
+  int next_image = 0;
+  const ros::WallTime wall0 = ros::WallTime::now();
+  for (double t = -0.1 + kPoseOffset; t <= t_end + 1e-9; t += kPosePeriod) {
+    while (next_image < kViews && next_image * kFramePeriod <= t) {
+      const double ti = next_image * kFramePeriod;
+      const Camera& cam = scene.scene.views[next_image].camera;
+      sensor_msgs::CameraInfo info = ros1::CameraInfoFromCamera(cam);
+      info.header.stamp = ros::Time(kT0 + ti);
+      info.header.frame_id = "camera_optical_frame";
+      const cv::Mat rgb = ros1::LinearToSrgb8(scene.images[next_image]);
+      sensor_msgs::Image im;
+      im.header = info.header;
+      im.width = rgb.cols;
+      im.height = rgb.rows;
+      im.encoding = sensor_msgs::image_encodings::RGB8;
+      im.step = rgb.cols * 3;
+      im.data.resize(static_cast<size_t>(im.step) * im.height);
+      for (int r = 0; r < rgb.rows; ++r)
+        std::memcpy(&im.data[static_cast<size_t>(r) * im.step], rgb.ptr(r),
+                    im.step);
+      info_pub.publish(info);
+      image_pub.publish(im);
+      ++next_image;
+    }
+    const Eigen::Isometry3d world_T_cam = CameraAt(scene, t);
+    const Eigen::Isometry3d world_T_body = world_T_cam * cam_T_body;
+    std_msgs::Header h;
+    h.stamp = ros::Time(kT0 + t);
+    h.frame_id = "odom";
+    nav_msgs::Odometry odom;
+    odom.header = h;
+    odom.child_frame_id = "base_link";
+    odom.pose.pose = PoseMsg(world_T_body);
+    odom_pub.publish(odom);
+    geometry_msgs::TransformStamped tfm;
+    tfm.header = h;
+    tfm.child_frame_id = "base_link";
+    const geometry_msgs::Pose pb = PoseMsg(world_T_body);
+    tfm.transform.translation.x = pb.position.x;
+    tfm.transform.translation.y = pb.position.y;
+    tfm.transform.translation.z = pb.position.z;
+    tfm.transform.rotation = pb.orientation;
+    tf_pub.publish(tfm);
+    geometry_msgs::PoseWithCovarianceStamped pwc;
+    pwc.header = h;
+    pwc.header.frame_id = "/odom";  // a leading slash, as old drivers send
+    pwc.pose.pose = PoseMsg(world_T_cam);
+    pwc_pub.publish(pwc);
+    // Paced like a live stream (slowed down), by wall time.
+    const ros::WallTime due = wall0 + ros::WallDuration((t + 0.1) * kSlowdown);
+    const ros::WallDuration wait = due - ros::WallTime::now();
+    if (wait > ros::WallDuration(0)) wait.sleep();
+  }
+
+  WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const std::string& n : nodes)
+          if (views[n].size() < static_cast<size_t>(kViews - 1)) return false;
+        return true;
+      },
+      200);
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const std::string& node : nodes) {
+    SCOPED_TRACE(node);
+    EXPECT_GE(views[node].size(), static_cast<size_t>(kViews - 1))
+        << diag.Dump(node);
+    for (const auto& [i, msg] : views[node]) {
+      ASSERT_GE(i, 0);
+      ASSERT_LT(i, kViews);
+      Camera cam;
+      ros1::CameraFromCameraInfo(msg->camera_info, &cam, nullptr);
+      ros1::SetCameraPose(msg->camera_pose.pose, &cam);
+      const Camera& truth = scene.scene.views[i].camera;
+      EXPECT_LT((cam.Center() - truth.Center()).norm(), 5e-4) << "view " << i;
+      const double angle =
+          Eigen::AngleAxisd(cam.R * truth.R.transpose()).angle();
+      EXPECT_LT(angle, 2e-4) << "view " << i;
+      cv::Mat d = ros1::FloatImageFromMsg(msg->depth, 1, "depth");
+      d.forEach<float>([](float& v, const int*) {
+        if (std::isnan(v)) v = 0;
+      });
+      const DepthMetrics m = EvaluateDepth(d, cam, scene.depth[i], truth);
+      EXPECT_GT(m.completeness, 0.3) << "view " << i << ": " << m.ToString();
+      EXPECT_LT(m.median_rel_error, 0.01) << "view " << i;
+    }
+    EXPECT_EQ(diag.Get(node, "frames dropped"), 0) << diag.Dump(node);
+    std::printf("[pose_sources] %s: %zu depth maps at the interpolated pose\n",
+                node.c_str(), views[node].size());
+  }
+}
+
+}  // namespace
+}  // namespace testing
+}  // namespace wild_mvs
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "rostest_pose_sources");
+  return RUN_ALL_TESTS();
+}
