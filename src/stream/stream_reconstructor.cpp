@@ -442,9 +442,9 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     const std::vector<KeyframePtr>& kfs = snap.keyframes;
     ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
     ViewReport report;
-    result.depth = ReconstructView(snap.scene, ref, cache, mvs,
-                                   inner_pool_.get(), &report, cv::Mat(),
-                                   &snap.points_per_view);
+    result.depth =
+        ReconstructView(snap.scene, ref, cache, mvs, inner_pool_.get(), &report,
+                        cv::Mat(), &snap.points_per_view);
     result.depth.view = static_cast<int>(id);
     result.depth.neighbors.clear();
     for (int n : report.neighbors) {
