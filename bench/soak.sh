@@ -17,6 +17,9 @@
 # SOAK_FUSION_MB=N sets the fusion node's memory bounds (map_store_mb,
 # fusion/map_cache_mb, fusion/pending_mb; defaults 256, 256, 128) to N MB
 # each, so that their plateau shows within the run.
+# SOAK_LINGER=N shows each view N frames in a row (a 30 Hz camera on a
+# robot moving one view step per N frames; default 1: every frame a new
+# view, so every frame is a keyframe).
 # Runs under nice -n 10. Needs a ROS build (scripts/common.sh wild_mvs_build).
 set -eo pipefail
 source "$(dirname "$0")/../scripts/common.sh"
@@ -81,7 +84,8 @@ sleep 3
 
 echo "soak: ${DURATION} s at ${RATE} Hz of $(basename "$DATASET") frames (depth at ${MAX_IMAGE_SIZE} px), CSV $OUT/soak.csv"
 nice -n 10 $PY "$WILD_MVS_ROOT/bench/soak_player.py" "$OUT/soak.bag" "$OUT/soak.csv" \
-  --rate "$RATE" --duration "$DURATION" --pid depth="$depth_pid" --pid fusion="$fusion_pid"
+  --rate "$RATE" --linger "${SOAK_LINGER:-1}" --duration "$DURATION" \
+  --pid depth="$depth_pid" --pid fusion="$fusion_pid"
 for p in "$depth_pid" "$fusion_pid"; do
   kill -0 "$p" 2>/dev/null || echo "soak: a node died (pid $p): see $OUT/*.log" >&2
 done

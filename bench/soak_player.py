@@ -9,7 +9,7 @@ keyframes, tracks, reconstructions and fusion keep running. Every
 --sample-period s it appends one CSV row: RSS and CPU of the node processes
 and the counters of their /diagnostics.
 
-  soak_player.py BAG CSV --rate HZ --duration S --pid depth=PID --pid fusion=PID
+  soak_player.py BAG CSV --rate HZ [--linger N] --duration S --pid depth=PID --pid fusion=PID
 """
 import argparse
 import csv
@@ -86,6 +86,8 @@ def main():
     ap.add_argument("bag")
     ap.add_argument("csv")
     ap.add_argument("--rate", type=float, default=20.0, help="frames per second")
+    ap.add_argument("--linger", type=int, default=1,
+                    help="frames per view in a row (1 = a new view every frame)")
     ap.add_argument("--duration", type=float, default=1800.0, help="seconds")
     ap.add_argument("--sample-period", type=float, default=10.0)
     ap.add_argument("--pid", action="append", default=[], help="NAME=PID")
@@ -131,7 +133,9 @@ def main():
         now = time.monotonic()
         if now - start >= args.duration:
             break
-        tf, info, im = frames[k % n]
+        # Each view `linger` frames in a row (a camera at the frame rate on
+        # a robot that moves one view step per linger frames).
+        tf, info, im = frames[(k // args.linger) % n]
         stamp = rospy.Time.from_sec(t0_stamp + k / args.rate)
         tf.transforms[0].header.stamp = stamp
         info.header.stamp = stamp
@@ -141,7 +145,7 @@ def main():
         image_pub.publish(im)
         k += 1
         if now - last_sample >= args.sample_period:
-            row = ["%.1f" % (now - start), k, k // n]
+            row = ["%.1f" % (now - start), k, k // (n * args.linger)]
             dt = now - last_sample
             for name in sorted(pids):
                 rss, cpu = proc_sample(pids[name])

@@ -81,7 +81,8 @@ OwnedImage MakeMatchImage(std::shared_ptr<const cv::Mat> img, bool color) {
 DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
                          const MvsOptions& options, ThreadPool* pool,
                          ViewReport* report, const cv::Mat& mask,
-                         const std::vector<std::vector<int>>* points_per_view) {
+                         const std::vector<std::vector<int>>* points_per_view,
+                         const std::atomic<bool>* cancel) {
   const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = ThreadCpuSeconds();
   double body_cpu = 0;
@@ -190,7 +191,8 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
     GrowStats stats;
     if (!seeds.empty())
       GrowRegions(ctx, options.mpgc, options.local, options.growing, seeds,
-                  wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats);
+                  wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats,
+                  cancel);
     if (stats.seeds_accepted == 0 ||
         stats.seeds_accepted < options.sweep.below_seeds) {
       // No (or too few) sparse features produced a match: seed the pixels
@@ -205,7 +207,7 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
       std::vector<Seed> swept;
       cv::Mat empty = dm.depth <= 0;  // CV_8U, 255 where nothing grew
       if (!wmask.empty()) empty &= wmask;
-      if (scene_depth > 0)
+      if (scene_depth > 0 && !(cancel && cancel->load()))
         swept = SweepSeeds(ctx, options.mpgc, options.local, options.sweep, lo,
                            hi, empty, pool, &body_cpu);
       const std::string why =
@@ -220,13 +222,16 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
               hi, "]: ", swept.size(), " seeds"));
       if (!swept.empty())
         GrowRegions(ctx, options.mpgc, options.local, options.growing, swept,
-                    wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats);
+                    wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats,
+                    cancel);
     }
     rep.seeds_tried = stats.seeds_tried;
     rep.seeds_accepted = stats.seeds_accepted;
     rep.pixel_visits = stats.pixel_visits;
     body_cpu += stats.cpu_seconds;
   }
+  if (cancel && cancel->load())
+    throw Cancelled(Msg("view '", scene.views[ref].name, "': cancelled"));
   rep.samples = dm.CountValid();
   rep.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0)

@@ -110,8 +110,10 @@ class RegionGrower {
   RegionGrower(const PatchContext& context, const MpgcOptions& mpgc,
                const LocalViewSelectionOptions& local,
                const RegionGrowingOptions& options, const cv::Mat& mask,
-               cv::Mat* depth, cv::Mat* normal, cv::Mat* confidence)
-      : cam_(context.ref_camera),
+               cv::Mat* depth, cv::Mat* normal, cv::Mat* confidence,
+               const std::atomic<bool>* cancel)
+      : cancel_(cancel),
+        cam_(context.ref_camera),
         opt_(options),
         matchers_(context, mpgc, local),
         W_(context.ref_image.width),
@@ -180,6 +182,7 @@ class RegionGrower {
   // Phases over the four tile colours until every queue is empty.
   void Grow(ThreadPool* pool) {
     for (;;) {
+      if (Cancelled()) break;
       bool any = false;
       for (size_t t = 0; t < queues_.size() && !any; ++t)
         any = !queues_[t].empty();
@@ -278,7 +281,15 @@ class RegionGrower {
     auto& q = queues_[tile];
     auto& out = outbox_[tile];
     PatchResult r;
+    int since_check = 0;
     while (!q.empty()) {
+      if (++since_check == 64) {
+        since_check = 0;
+        if (Cancelled()) {
+          q.clear();
+          break;
+        }
+      }
       std::pop_heap(q.begin(), q.end(), Lower());
       const Candidate c = q.back();
       q.pop_back();
@@ -335,6 +346,11 @@ class RegionGrower {
     }
   }
 
+  bool Cancelled() const {
+    return cancel_ && cancel_->load(std::memory_order_relaxed);
+  }
+
+  const std::atomic<bool>* cancel_;  // null = never
   const Camera& cam_;
   const RegionGrowingOptions& opt_;
   MatcherPool matchers_;
@@ -358,7 +374,8 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
                  const RegionGrowingOptions& options,
                  const std::vector<Seed>& seeds, const cv::Mat& mask,
                  ThreadPool* pool, cv::Mat* depth, cv::Mat* normal,
-                 cv::Mat* confidence, GrowStats* stats) {
+                 cv::Mat* confidence, GrowStats* stats,
+                 const std::atomic<bool>* cancel) {
   options.Check();
   const int W = context.ref_image.width, H = context.ref_image.height;
   Require(depth && normal && confidence, "GrowRegions: null output");
@@ -377,7 +394,7 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
               (mask.cols == W && mask.rows == H && mask.type() == CV_8U),
           "GrowRegions: mask must be CV_8U ", W, "x", H);
   RegionGrower grower(context, mpgc, local, options, mask, depth, normal,
-                      confidence);
+                      confidence, cancel);
   grower.SeedQueues(seeds, pool);
   grower.Grow(pool);
   if (stats) {

@@ -70,12 +70,19 @@ StreamReconstructor::StreamReconstructor(const StreamOptions& options,
   last_keyframe_wall_ = WallSeconds();
 }
 
-StreamReconstructor::~StreamReconstructor() {
+StreamReconstructor::~StreamReconstructor() { Shutdown(); }
+
+void StreamReconstructor::Shutdown() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (shut_down_) return;
+    shut_down_ = true;
     stopping_ = true;
     ++generation_;
   }
+  // A running depth map stops within a few pixels per tile (a node shutting
+  // down must end within roslaunch's SIGINT-to-SIGKILL escalation).
+  cancel_ = true;
   dispatcher_.reset();  // queued tasks return at once; waits for a running one
   inner_pool_.reset();
 }
@@ -426,6 +433,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     session = session_;
     session_ns = session_ns_;
     mvs = options_.mvs;  // SetOptions may change it meanwhile
+    ++stats_.running;
   }
   StreamResult result;
   result.keyframe_id = id;
@@ -444,7 +452,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     ViewReport report;
     result.depth =
         ReconstructView(snap.scene, ref, cache, mvs, inner_pool_.get(), &report,
-                        cv::Mat(), &snap.points_per_view);
+                        cv::Mat(), &snap.points_per_view, &cancel_);
     result.depth.view = static_cast<int>(id);
     result.depth.neighbors.clear();
     for (int n : report.neighbors) {
@@ -455,6 +463,13 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       result.depth.neighbors.push_back(static_cast<int>(kfs[n]->id));
     }
     for (double s : report.neighbor_scores) score += s;
+  } catch (const Cancelled&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --stats_.running;
+    ++stats_.cancelled;
+    in_flight_.erase(id);
+    idle_cv_.notify_all();
+    return;  // shutting down: nothing to deliver
   } catch (const std::exception& e) {
     error = e.what();
   }
@@ -464,6 +479,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   bool deliver = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    --stats_.running;
     in_flight_.erase(id);
     if (generation != generation_) {
       ++stats_.stale_results;

@@ -319,6 +319,37 @@ TEST(StreamReconstructor, SetOptionsRetunesKeyframeSelectionLive) {
             S::kKeyframe);
 }
 
+// Shutdown cancels a running depth map (a node must end within roslaunch's
+// SIGINT-to-SIGKILL escalation, whatever the image size): the map in
+// progress is stopped and counted, nothing is delivered.
+TEST(StreamReconstructor, ShutdownCancelsARunningDepthMap) {
+  testing::SyntheticSpec spec = testing::RosTestSpec(4);
+  spec.width = 640;  // a depth map of several CPU-seconds
+  spec.height = 480;
+  spec.focal = 600;
+  const SyntheticScene s = testing::Render(spec);
+  StreamOptions o = FastOptions();
+  o.num_threads = 1;
+  o.lookahead = 0;
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  stream.SetSparsePoints(StampedPoints(s));
+  for (size_t i = 0; i < s.scene.views.size(); ++i)
+    stream.AddFrame(double(i), "camera", s.scene.views[i].camera, s.images[i]);
+  // Wait (on the condition) until a depth map is being computed.
+  for (int k = 0; k < 60000 && stream.Stats().running == 0; ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_EQ(stream.Stats().running, 1);
+  stream.Shutdown();
+  const StreamStats st = stream.Stats();
+  EXPECT_EQ(st.cancelled, 1u);
+  EXPECT_EQ(st.running, 0);
+  EXPECT_EQ(st.reconstructed, 0u);
+  std::lock_guard<std::mutex> lock(c.mutex);
+  EXPECT_TRUE(c.results.empty());
+  EXPECT_TRUE(c.errors.empty());
+}
+
 TEST(StreamReconstructor, StoreStaysBoundedOnALongStream) {
   const SyntheticScene& s = Scene6();
   StreamOptions o = FastOptions();

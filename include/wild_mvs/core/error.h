@@ -17,6 +17,12 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& what) : std::runtime_error(what) {}
 };
 
+// A computation stopped because its caller asked (a node shutting down).
+class Cancelled : public Error {
+ public:
+  explicit Cancelled(const std::string& what) : Error(what) {}
+};
+
 // Builds a message from streamable parts: throw Error(Msg("x = ", x)).
 template <typename... Args>
 std::string Msg(const Args&... args) {

@@ -3,6 +3,7 @@
 // reference view (Goesele et al. 2007; docs/ALGORITHM.md sections 1-5).
 #pragma once
 
+#include <atomic>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -65,13 +66,16 @@ struct ViewReport {
 // images (resized copies come from it). pool may be null (inline) and must
 // not be the pool this call runs on (ThreadPool::ParallelFor). mask: CV_8U of
 // the reference image's size, 0 = ignore (empty = none). Deterministic: the
-// same output whatever the number of threads. Throws Error on bad input.
+// same output whatever the number of threads. Throws Error on bad input,
+// and Cancelled when *cancel became true while it ran (another thread: a
+// node shutting down; the growing stops within a few pixels per tile).
 // points_per_view: scene.PointsPerView() when the caller reconstructs many
 // views of one scene (computed once: it costs O(points x track length), i.e.
 // grows with the collection); null = computed here.
 DepthMap ReconstructView(
     const Scene& scene, int ref, ImageCache& images, const MvsOptions& options,
     ThreadPool* pool, ViewReport* report, const cv::Mat& mask = cv::Mat(),
-    const std::vector<std::vector<int>>* points_per_view = nullptr);
+    const std::vector<std::vector<int>>* points_per_view = nullptr,
+    const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace wild_mvs

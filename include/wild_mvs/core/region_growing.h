@@ -10,6 +10,7 @@
 // not depend on the number of threads.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -72,12 +73,15 @@ double ThreadCpuSeconds();
 // Grows depth/normal/confidence (CV_32F / CV_32FC3 / CV_32F of R's working
 // size, filled by the caller with zeros or earlier results) from `seeds`,
 // matched fronto-parallel. mask (CV_8U of the working size, may be empty):
-// 0 = never seed or grow there. pool may be null (inline).
+// 0 = never seed or grow there. pool may be null (inline). When *cancel
+// becomes true (another thread), growing stops within a few pixels per
+// tile and the maps hold what grew so far.
 void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
                  const LocalViewSelectionOptions& local,
                  const RegionGrowingOptions& options,
                  const std::vector<Seed>& seeds, const cv::Mat& mask,
                  ThreadPool* pool, cv::Mat* depth, cv::Mat* normal,
-                 cv::Mat* confidence, GrowStats* stats);
+                 cv::Mat* confidence, GrowStats* stats,
+                 const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace wild_mvs

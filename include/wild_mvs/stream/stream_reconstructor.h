@@ -121,7 +121,9 @@ struct StreamStats {
   // Scheduling passes that evaluated the keyframes' neighbourhoods (a
   // snapshot of the store each): only when something changed.
   uint64_t scheduling_passes = 0;
-  double session = -1;  // stamp that started the current session (-1: none)
+  uint64_t cancelled = 0;  // depth maps stopped by Shutdown()
+  int running = 0;         // depth maps being computed now
+  double session = -1;     // stamp that started the current session (-1: none)
   size_t sparse_points = 0;
   // Memory of the online tracker (SparseTracker::bytes()): it keeps a few
   // bytes per feature of every keyframe ever added, also after eviction.
@@ -136,7 +138,11 @@ class StreamReconstructor {
 
   StreamReconstructor(const StreamOptions& options, ResultCallback on_result,
                       ErrorCallback on_error = nullptr);
-  ~StreamReconstructor();  // waits for running reconstructions
+  ~StreamReconstructor();  // Shutdown()
+  // Stops for good: queued reconstructions are dropped and a running one is
+  // cancelled (it stops within a few pixels per tile; nothing is
+  // delivered); returns once it has. Stats() stays valid.
+  void Shutdown();
 
   enum class FrameStatus {
     kKeyframe,     // kept as a keyframe
@@ -234,8 +240,11 @@ class StreamReconstructor {
   int ready_waiting_ = 0;
   uint32_t next_id_ = 0;
   uint64_t generation_ = 0;
-  bool idle_scheduled_ = false;    // the idle flush ran since the last keyframe
-  double last_keyframe_wall_ = 0;  // steady clock, s
+  bool idle_scheduled_ = false;
+  std::atomic<bool> cancel_{false};  // set by Shutdown()
+  bool shut_down_ = false;    // the idle
+                                     // flush ran since the last keyframe
+  double last_keyframe_wall_ = 0;    // steady clock, s
   double last_stamp_ = -1;
   double session_ = -1;  // see StreamResult::session
   uint64_t session_ns_ = 0;
