@@ -138,14 +138,24 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
 
 #else  // vector targets: at least 4 float lanes
 
+// v's 128-bit blocks added up (lane l of the result = the sum of the lanes
+// l mod 4): all vector adds.
+template <class D>
+HWY_INLINE hn::Vec<hn::FixedTag<float, 4>> FoldTo128(D d, hn::Vec<D> v) {
+  if constexpr (hn::MaxLanes(d) > 4) {
+    const hn::Half<D> dh;
+    return FoldTo128(dh, hn::Add(hn::LowerHalf(dh, v), hn::UpperHalf(dh, v)));
+  } else {
+    return v;
+  }
+}
+
 // Lane sums of v folded to the 4 channel lanes (lane l -> channel l % 4).
 template <class D, class V>
 HWY_INLINE void FoldChannels(D d, V v, double out[4]) {
-  alignas(64) float lanes[64];
-  hn::Store(v, d, lanes);
-  out[0] = out[1] = out[2] = out[3] = 0;
-  const size_t n = hn::Lanes(d);
-  for (size_t l = 0; l < n; ++l) out[l & 3] += lanes[l];
+  alignas(16) float lanes[4];
+  hn::Store(FoldTo128(d, v), hn::FixedTag<float, 4>(), lanes);
+  for (int c = 0; c < 4; ++c) out[c] = lanes[c];
 }
 
 template <class D, class V>
@@ -307,7 +317,20 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
   const auto sc = Channels(d, sc4);
   // Pass 1: the window means of q, q i, q j, I and e per channel.
   double m[5][4] = {};
-  if (center) {
+  if (center && depth_only) {
+    auto sq = hn::Zero(d), se = sq;
+    for (int k = 0; k < nf; k += n) {
+      const auto I = hn::Load(d, val + k);
+      sq = hn::MulAdd(sc, hn::Load(d, dval + k), sq);
+      se = hn::Add(se, hn::Sub(hn::Load(d, ref + k), hn::Mul(sc, I)));
+    }
+    FoldChannels(d, sq, m[0]);
+    FoldChannels(d, se, m[4]);
+    for (int c = 0; c < 4; ++c) {
+      m[0][c] /= npix;
+      m[4][c] /= npix;
+    }
+  } else if (center) {
     auto sq = hn::Zero(d), sqi = sq, sqj = sq, si = sq, se = sq;
     for (int k = 0; k < nf; k += n) {
       const auto I = hn::Load(d, val + k);
