@@ -141,7 +141,7 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
 // v's 128-bit blocks added up (lane l of the result = the sum of the lanes
 // l mod 4): all vector adds.
 template <class D>
-HWY_INLINE hn::Vec<hn::FixedTag<float, 4>> FoldTo128(D d, hn::Vec<D> v) {
+HWY_INLINE hn::Vec<hn::FixedTag<float, 4> > FoldTo128(D d, hn::Vec<D> v) {
   if constexpr (hn::MaxLanes(d) > 4) {
     const hn::Half<D> dh;
     return FoldTo128(dh, hn::Add(hn::LowerHalf(dh, v), hn::UpperHalf(dh, v)));
@@ -178,6 +178,32 @@ template <class D>
 HWY_INLINE int Floats(D d, int npix) {
   const int n = static_cast<int>(hn::Lanes(d));
   return (4 * npix + n - 1) / n * n;
+}
+
+// The 4-float pixels at p[q] + off (q < lanes / 4) side by side.
+template <class D>
+HWY_INLINE hn::Vec<D> LoadPixels(D d, const float* const* p, size_t off) {
+  if constexpr (hn::MaxLanes(d) > 4) {
+    const hn::Half<D> dh;
+    constexpr size_t kHalf = hn::MaxLanes(d) / 8;  // pixels per half
+    return hn::Combine(d, LoadPixels(dh, p + kHalf, off),
+                       LoadPixels(dh, p, off));
+  } else {
+    return hn::LoadU(d, p[0] + off);
+  }
+}
+
+// One value per pixel (v[q], q < lanes / 4) repeated over its 4 lanes.
+template <class D>
+HWY_INLINE hn::Vec<D> PerPixel(D d, const float* v) {
+  if constexpr (hn::MaxLanes(d) > 4) {
+    alignas(64) static constexpr int32_t kRep[16] = {0, 0, 0, 0, 1, 1, 1, 1,
+                                                     2, 2, 2, 2, 3, 3, 3, 3};
+    return hn::TableLookupLanes(hn::LoadDup128(d, v),
+                                hn::SetTableIndices(d, kRep));
+  } else {
+    return hn::Set(d, v[0]);
+  }
 }
 
 bool SampleWindowImpl(const SampleArgs& s, float* HWY_RESTRICT val,
@@ -231,49 +257,64 @@ bool SampleWindowImpl(const SampleArgs& s, float* HWY_RESTRICT val,
                 dys + k);
     }
   }
-  // 2. Bilinear interpolation per pixel, the channels in the lanes of one
-  // 128-bit vector loaded straight from the interleaved image (lanes past
-  // the channels hold the next pixel's values and are zeroed).
-  const hn::FixedTag<float, 4> d4;
-  const auto keep = hn::FirstN(d4, static_cast<size_t>(s.channels));
+  // 2. Bilinear interpolation, P = lanes / 4 pixels per vector: each
+  // pixel's channels are one 128-bit load straight from the interleaved
+  // image (lanes past the channels hold the next pixel's values and are
+  // zeroed), so the window is written in its 4-lane layout with no shuffle.
+  const hn::ScalableTag<float> d;
+  const int P = static_cast<int>(hn::Lanes(d)) / 4;
+  alignas(64) static constexpr float kLane4[16] = {0, 1, 2, 3, 0, 1, 2, 3,
+                                                   0, 1, 2, 3, 0, 1, 2, 3};
+  const auto chan_keep = hn::Lt(hn::Load(d, kLane4), hn::Set(d, s.channels));
   const size_t C = static_cast<size_t>(s.channels);
   const size_t row = static_cast<size_t>(s.width) * C;
   const size_t total = row * static_cast<size_t>(s.height);
-  for (int k = 0; k < s.npix; ++k) {
-    const size_t o00 = static_cast<size_t>(y0s[k]) * row + x0s[k] * C;
-    const float* p00 = s.data + o00;
-    const float* p01 = p00 + row;
-    hn::Vec<decltype(d4)> v00, v10, v01, v11;
-    if (o00 + row + C + 4 <= total) {
-      v00 = hn::LoadU(d4, p00);
-      v10 = hn::LoadU(d4, p00 + C);
-      v01 = hn::LoadU(d4, p01);
-      v11 = hn::LoadU(d4, p01 + C);
-    } else {  // the image's last pixels: never read past its end
-      alignas(16) float t[4][4] = {};
-      for (size_t c = 0; c < C; ++c) {
-        t[0][c] = p00[c];
-        t[1][c] = p00[C + c];
-        t[2][c] = p01[c];
-        t[3][c] = p01[C + c];
-      }
-      v00 = hn::Load(d4, t[0]);
-      v10 = hn::Load(d4, t[1]);
-      v01 = hn::Load(d4, t[2]);
-      v11 = hn::Load(d4, t[3]);
+  for (int k = 0; k < s.npix; k += P) {
+    const float* p00[4];
+    const float* p01[4];
+    bool inside = true;
+    for (int q = 0; q < P; ++q) {
+      const size_t o = static_cast<size_t>(y0s[k + q]) * row + x0s[k + q] * C;
+      p00[q] = s.data + o;
+      p01[q] = p00[q] + row;
+      inside = inside && o + row + C + 4 <= total;
     }
-    const auto fx = hn::Set(d4, fxs[k]), fy = hn::Set(d4, fys[k]);
+    hn::Vec<decltype(d)> v00, v10, v01, v11;
+    if (inside) {
+      v00 = LoadPixels(d, p00, 0);
+      v10 = LoadPixels(d, p00, C);
+      v01 = LoadPixels(d, p01, 0);
+      v11 = LoadPixels(d, p01, C);
+    } else {  // the image's last pixels: never read past its end
+      alignas(64) float t[4][64] = {};
+      for (int q = 0; q < P; ++q)
+        for (size_t c = 0; c < C; ++c) {
+          t[0][4 * q + c] = p00[q][c];
+          t[1][4 * q + c] = p00[q][C + c];
+          t[2][4 * q + c] = p01[q][c];
+          t[3][4 * q + c] = p01[q][C + c];
+        }
+      v00 = hn::Load(d, t[0]);
+      v10 = hn::Load(d, t[1]);
+      v01 = hn::Load(d, t[2]);
+      v11 = hn::Load(d, t[3]);
+    }
+    auto keep = chan_keep;
+    if (k + P > s.npix)
+      keep =
+          hn::And(keep, hn::FirstN(d, static_cast<size_t>(4 * (s.npix - k))));
+    const auto fx = PerPixel(d, fxs + k), fy = PerPixel(d, fys + k);
     const auto dtop = hn::Sub(v10, v00), dbot = hn::Sub(v11, v01);
     const auto top = hn::Add(v00, hn::Mul(fx, dtop));
     const auto bot = hn::Add(v01, hn::Mul(fx, dbot));
     const auto gy = hn::Sub(bot, top);
-    hn::Store(hn::IfThenElseZero(keep, hn::Add(top, hn::Mul(fy, gy))), d4,
+    hn::Store(hn::IfThenElseZero(keep, hn::Add(top, hn::Mul(fy, gy))), d,
               val + 4 * k);
     if (dval) {
       const auto gx = hn::Add(dtop, hn::Mul(fy, hn::Sub(dbot, dtop)));
-      const auto dv = hn::Add(hn::Mul(gx, hn::Set(d4, dxs[k])),
-                              hn::Mul(gy, hn::Set(d4, dys[k])));
-      hn::Store(hn::IfThenElseZero(keep, dv), d4, dval + 4 * k);
+      const auto dv = hn::Add(hn::Mul(gx, PerPixel(d, dxs + k)),
+                              hn::Mul(gy, PerPixel(d, dys + k)));
+      hn::Store(hn::IfThenElseZero(keep, dv), d, dval + 4 * k);
     }
   }
   return true;
