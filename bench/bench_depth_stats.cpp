@@ -15,8 +15,9 @@
 //   correct      in_bbox and consistent (all consistent without --bbox);
 //   with --gt:   completeness (fraction of ground-truth pixels with an
 //                estimate), fraction of the estimated pixels within 1 cm and
-//                2 cm, median absolute error, over the pixels with ground
-//                truth.
+//                2 cm and within 1 % of the true depth (and their count,
+//                correct_1pct: issue 12's "correct" on fountain-P11), median
+//                absolute error, over the pixels with ground truth.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -38,6 +39,7 @@ namespace {
 struct Totals {
   long long samples = 0, in_bbox = 0, consistent = 0, correct = 0;
   long long gt_valid = 0, evaluated = 0, within1 = 0, within2 = 0;
+  long long within_rel = 0;  // |d - g| <= 0.01 g
   std::vector<float> errors;
 };
 
@@ -108,6 +110,7 @@ int main(int argc, char** argv) {
             ++t.evaluated;
             if (e <= 0.01f) ++t.within1;
             if (e <= 0.02f) ++t.within2;
+            if (e <= 0.01f * g) ++t.within_rel;
             t.errors.push_back(e);
           }
           const Eigen::Vector3d X =
@@ -143,6 +146,7 @@ int main(int argc, char** argv) {
       tot.evaluated += t.evaluated;
       tot.within1 += t.within1;
       tot.within2 += t.within2;
+      tot.within_rel += t.within_rel;
       tot.errors.insert(tot.errors.end(), t.errors.begin(), t.errors.end());
     }
     std::printf(
@@ -153,9 +157,10 @@ int main(int argc, char** argv) {
       const double ev = std::max<long long>(1, tot.evaluated);
       std::printf(
           " gt_completeness=%.4f within_1cm=%.4f within_2cm=%.4f "
-          "median_error_m=%.5f",
+          "within_1pct=%.4f correct_1pct=%lld median_error_m=%.5f",
           tot.evaluated / std::max(1.0, double(tot.gt_valid)), tot.within1 / ev,
-          tot.within2 / ev, Median(tot.errors));
+          tot.within2 / ev, tot.within_rel / ev, tot.within_rel,
+          Median(tot.errors));
     }
     std::printf("\n");
   } catch (const std::exception& e) {

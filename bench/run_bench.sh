@@ -1,39 +1,57 @@
 #!/usr/bin/env bash
-# MVS benchmark (issue 3, section 7; not a test). Builds the ROS-free tree,
-# then reconstructs
-#   - templeSparseRing, all 16 views at full resolution (640x480);
-#   - fountain-P11, all 11 views at half resolution (1536x1024);
-# with the colmap_sift_gt models and the default options, one view at a time
-# with every thread inside the view, and prints a table: wall and CPU
-# seconds (total and per depth map), valid samples, samples per CPU second,
-# peak RSS, and the quality numbers of bench_depth_stats (temple: samples in
-# the README's bounding box enlarged by 5 mm and samples consistent with
-# another view within 0.5 % of depth; fountain: completeness, fraction
-# within 1 / 2 cm and median error against the ground-truth depth).
+# MVS benchmark (issue 12; not a test). Builds the ROS-free tree, then runs
+# the depth stage of `wild_mvs reconstruct` (whole process, default options,
+# the consistency filter included) on
+#   - templeSparseRing, all 16 views at 640x480, its colmap_sift_gt model;
+#   - fountain-P11, all 11 views at 1536x1024 (--max-image-size 1536);
+# N times each (--runs, default 3) and reports the median of: CPU seconds
+# (user + sys of the whole process, /usr/bin/time), samples, correct
+# samples, correct samples per CPU second and peak RSS, beside the
+# reference implementation's (MVE dmrecon) figures from issue 12.
+#   temple   correct = inside the object's bounding box (README.txt) + 5 mm
+#            and consistent with another view's map within 0.5 % of depth;
+#   fountain correct = within 1 % of the ground-truth depth.
+# (both by bench_depth_stats). Raw outputs (the /usr/bin/time lines, logs,
+# stats) and table.tsv go to bench/results/<UTC date>-<tag>/ (commit them);
+# the depth maps to a temporary folder (--keep-maps to keep it).
 #
-# Usage: bench/run_bench.sh [--threads N] [--out DIR] [--skip-build]
-#                           [--only temple|fountain] [-- EXTRA bench_mvs ARGS]
-# Environment: WILD_MVS_DATASETS (default: ../shared/datasets of the repo).
-# Takes many minutes (about 2-4 CPU-minutes on an idle core per dataset).
+# Usage: bench/run_bench.sh [--runs N] [--threads N] [--tag TAG]
+#            [--only temple|fountain] [--skip-build] [--results DIR]
+#            [--keep-maps] [-- EXTRA wild_mvs reconstruct ARGS]
+# Environment: WILD_MVS_DATASETS (default: ../shared/datasets of the repo),
+# BUILD_DIR (default: build-bench).
+# Cost: temple about 35 CPU-s per run, fountain about 300-450 CPU-s.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 DATASETS="${WILD_MVS_DATASETS:-$ROOT/../shared/datasets}"
 THREADS=2
-OUT=""
+RUNS=3
+TAG=""
+RESULTS=""
 BUILD=1
 ONLY=""
+KEEP=0
 EXTRA=()
 while [ $# -gt 0 ]; do
   case "$1" in
+    --runs) RUNS="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
-    --out) OUT="$2"; shift 2 ;;
+    --tag) TAG="$2"; shift 2 ;;
+    --results) RESULTS="$2"; shift 2 ;;
     --skip-build) BUILD=0; shift ;;
     --only) ONLY="$2"; shift 2 ;;
+    --keep-maps) KEEP=1; shift ;;
     --) shift; EXTRA=("$@"); break ;;
     *) echo "run_bench.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
+case "$ONLY" in "" | temple | fountain) ;; *)
+  echo "run_bench.sh: --only takes temple or fountain, not '$ONLY'" >&2
+  exit 2 ;;
+esac
+[[ "$RUNS" =~ ^[1-9][0-9]*$ ]] || { echo "run_bench.sh: --runs must be >= 1" >&2; exit 2; }
 [ -d "$DATASETS" ] || { echo "run_bench.sh: no datasets at $DATASETS" >&2; exit 1; }
+[ -x /usr/bin/time ] || { echo "run_bench.sh: needs /usr/bin/time (Debian package 'time')" >&2; exit 1; }
 # Its own ROS-free build folder, so the main build/ keeps its configuration.
 export BUILD_DIR="${BUILD_DIR:-$ROOT/build-bench}"
 if [ "$BUILD" = 1 ]; then
@@ -43,55 +61,88 @@ if [ "$BUILD" = 1 ]; then
   JOBS="${JOBS:-2}" wild_mvs_build -DWILD_MVS_WITH_ROS=OFF >/dev/null
 fi
 BIN="$BUILD_DIR/bin"
-[ -n "$OUT" ] || OUT="$(mktemp -d /tmp/wild_mvs_bench.XXXXXX)"
-mkdir -p "$OUT"
-
-# run NAME MODEL IMAGES [bench_mvs args...]: reconstruct into $OUT/NAME.
-run() {
-  local name="$1" model="$2" images="$3"
-  shift 3
-  echo "== $name: bench_mvs $*" >&2
-  "$BIN/bench_mvs" "$model" "$images" \
-    --threads "$THREADS" --save "$OUT/$name" "$@" ${EXTRA[@]+"${EXTRA[@]}"} \
-    | tee "$OUT/$name.txt" >&2
-}
-
-# field KEY FILE: value of KEY=... on the TOTAL line.
-field() { grep '^TOTAL' "$2" | tr ' ' '\n' | sed -n "s/^$1=//p" | grep . || echo -; }
-
+if [ -z "$RESULTS" ]; then
+  commit=$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)
+  RESULTS="$ROOT/bench/results/$(date -u +%Y-%m-%dT%H%M)-${TAG:-$commit}"
+fi
+mkdir -p "$RESULTS"
+MAPS="$(mktemp -d /tmp/wild_mvs_bench.XXXXXX)"
+[ "$KEEP" = 1 ] || trap 'rm -rf "$MAPS"' EXIT
 T="$DATASETS/middlebury_templeSparseRing"
 F="$DATASETS/strecha_fountain-P11"
-ROWS=()
+
+# field KEY FILE: value of KEY=... on the TOTAL line of a stats file.
+field() { grep '^TOTAL' "$2" | tr ' ' '\n' | sed -n "s/^$1=//p" | grep . || echo -; }
+# median of the arguments (numbers).
+median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}'; }
+
+{
+  echo "# wild_mvs bench $(date -u +%FT%TZ), commit $(git -C "$ROOT" rev-parse HEAD 2>/dev/null || echo unknown)"
+  echo "# host $(uname -n), $(nproc) cores: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-)"
+  echo "# threads $THREADS, runs $RUNS, extra args: ${EXTRA[*]+${EXTRA[*]}}"
+} >"$RESULTS/README.txt"
+
+TSV="$RESULTS/table.tsv"
+printf 'dataset\timpl\truns\tcpu_s\tsamples\tcorrect\tcorrect_fraction\tcorrect_per_cpu_s\tpeak_rss_mb\n' >"$TSV"
+
+# bench NAME: RUNS runs of the depth stage on dataset NAME, one TSV row.
+bench() {
+  local name="$1" k cpus=() samples=() corrects=() rates=() rss=()
+  for k in $(seq 1 "$RUNS"); do
+    local out="$MAPS/$name.run$k" base="$RESULTS/$name.run$k"
+    rm -rf "$out"
+    local args=()
+    if [ "$name" = temple ]; then
+      args=("$T" "$out" --model "$T/colmap_sift_gt" --images "$T")
+    else
+      args=("$F" "$out" --model "$F/colmap_sift_gt" --images "$F/images"
+            --max-image-size 1536)
+    fi
+    echo "== $name run $k/$RUNS: wild_mvs reconstruct ${args[*]} --stages depth --threads $THREADS ${EXTRA[*]+${EXTRA[*]}}" >&2
+    /usr/bin/time -f "%U %S %M" -o "$base.time" \
+      "$BIN/wild_mvs" reconstruct "${args[@]}" --stages depth \
+      --threads "$THREADS" ${EXTRA[@]+"${EXTRA[@]}"} >"$base.log" 2>&1 ||
+      { echo "run_bench.sh: wild_mvs failed, see $base.log" >&2; exit 1; }
+    if [ "$name" = temple ]; then
+      "$BIN/bench_depth_stats" "$T/colmap_sift_gt" "$T" "$out" \
+        --bbox -0.073568 0.021728 -0.012445 0.028855 0.181892 0.062736 \
+        --margin 0.005 --consistency 0.005 >"$base.stats"
+      corrects+=("$(field correct "$base.stats")")
+    else
+      "$BIN/bench_depth_stats" "$F/colmap_sift_gt" "$F/images" "$out" \
+        --gt "$F" --consistency 0.01 >"$base.stats"
+      corrects+=("$(field correct_1pct "$base.stats")")
+    fi
+    samples+=("$(field samples "$base.stats")")
+    read -r user sys maxkb <"$base.time"
+    local cpu
+    cpu=$(echo "$user + $sys" | bc -l)
+    cpus+=("$cpu")
+    rss+=("$(echo "$maxkb / 1024" | bc -l)")
+    rates+=("$(echo "${corrects[-1]} / $cpu" | bc -l)")
+    tail -n 1 "$base.stats" >&2
+    echo "   cpu_s=$cpu peak_rss_kb=$maxkb" >&2
+  done
+  local s c
+  s=$(median "${samples[@]}")
+  c=$(median "${corrects[@]}")
+  printf '%s\twild_mvs\t%s\t%.1f\t%.0f\t%.0f\t%.4f\t%.0f\t%.0f\n' "$name" "$RUNS" \
+    "$(median "${cpus[@]}")" "$s" "$c" "$(echo "$c / $s" | bc -l)" \
+    "$(median "${rates[@]}")" "$(median "${rss[@]}")" >>"$TSV"
+}
+
 if [ -z "$ONLY" ] || [ "$ONLY" = temple ]; then
-  run temple "$T/colmap_sift_gt" "$T"
-  "$BIN/bench_depth_stats" "$T/colmap_sift_gt" "$T" "$OUT/temple" \
-    --bbox -0.073568 0.021728 -0.012445 0.028855 0.181892 0.062736 \
-    --margin 0.005 --consistency 0.005 | tee "$OUT/temple.stats" >&2
-  ROWS+=(temple)
+  bench temple
+  # Issue 12: MVE dmrecon on the same input (rss not measured).
+  printf 'temple\treference_mve_dmrecon\t1\t210.8\t756591\t714859\t%.4f\t%.0f\t-\n' \
+    "$(echo "714859 / 756591" | bc -l)" "$(echo "714859 / 210.8" | bc -l)" >>"$TSV"
 fi
 if [ -z "$ONLY" ] || [ "$ONLY" = fountain ]; then
-  run fountain "$F/colmap_sift_gt" "$F/images" --max-image-size 1536
-  "$BIN/bench_depth_stats" "$F/colmap_sift_gt" "$F/images" "$OUT/fountain" \
-    --gt "$F" --consistency 0.01 | tee "$OUT/fountain.stats" >&2
-  ROWS+=(fountain)
+  bench fountain
+  printf 'fountain\treference_mve_dmrecon\t1\t2044\t11300000\t%.0f\t0.9660\t%.0f\t-\n' \
+    "$(echo "0.966 * 11300000" | bc -l)" "$(echo "0.966 * 11300000 / 2044" | bc -l)" >>"$TSV"
 fi
 
-printf '\n%-9s %5s %9s %8s %8s %9s %9s %13s %7s %9s %10s %8s %6s %6s %8s\n' \
-  dataset views samples wall_s cpu_s wall/map cpu/map samples/cpu_s rss_MB \
-  in_bbox consistent complete "<=1cm" "<=2cm" median_m
-for name in "${ROWS[@]}"; do
-  txt="$OUT/$name.txt"
-  st="$OUT/$name.stats"
-  views=$(field views "$txt")
-  wall=$(field seconds "$txt")
-  cpu=$(field cpu_seconds "$txt")
-  printf '%-9s %5s %9s %8.1f %8.1f %9.2f %9.2f %13s %7s %9s %10s %8s %6s %6s %8s\n' \
-    "$name" "$views" "$(field samples "$txt")" "$wall" "$cpu" \
-    "$(echo "$wall / $views" | bc -l)" "$(echo "$cpu / $views" | bc -l)" \
-    "$(field samples_per_cpu_second "$txt")" "$(field peak_rss_mb "$txt")" \
-    "$(field in_bbox "$st")" "$(field correct "$st")" \
-    "$(field gt_completeness "$st")" "$(field within_1cm "$st")" \
-    "$(field within_2cm "$st")" "$(field median_error_m "$st")"
-done
-echo "(outputs in $OUT; temple 'consistent' = in the box and consistent;" \
-  "fountain 'consistent' = consistent with another view within 1 %)"
+echo >&2
+column -t -s $'\t' "$TSV" >&2
+echo "(medians of $RUNS runs; raw outputs in $RESULTS)" >&2

@@ -6,7 +6,7 @@
 set -eo pipefail
 export DEBIAN_FRONTEND=noninteractive
 CORE="build-essential cmake pkg-config git libgtest-dev libgmock-dev libeigen3-dev libopencv-dev \
- libpcl-dev libyaml-cpp-dev libopenexr-dev"
+ libpcl-dev libyaml-cpp-dev libopenexr-dev libhwy-dev"
 ROS="catkin ros-message-generation ros-message-runtime \
  libroscpp-dev libstd-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure \
  ros-std-msgs ros-sensor-msgs ros-geometry-msgs \

@@ -83,6 +83,28 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
   max_angle_rad_ = local_.max_epipolar_angle_deg * M_PI / 180.0;
   for (size_t v = 0; v < ctx_.views.size(); ++v)
     global_scores_[v] = ctx_.views[v].global_score;
+  // The kernels' constant per-lane tables; every unused lane stays zero.
+  constexpr int nf = mpgc_kernels::kWindowFloats;
+  std::fill(ref_, ref_ + nf, 0.0f);
+  std::fill(ref_centered_, ref_centered_ + nf, 0.0f);
+  std::fill(mask_, mask_ + nf, 0.0f);
+  std::fill(wi_, wi_ + nf, 0.0f);
+  std::fill(wj_, wj_ + nf, 0.0f);
+  for (int k = 0; k < mpgc_kernels::kWindowPixels; ++k) {
+    const int p = k < npix_ ? k : 0;  // padding repeats pixel 0
+    oi_[k] = p % n_ - half_;
+    oj_[k] = p / n_ - half_;
+  }
+  for (int k = 0; k < npix_; ++k)
+    for (int c = 0; c < 4; ++c) {
+      mask_[4 * k + c] = c < channels_ ? 1.0f : 0.0f;
+      wi_[4 * k + c] = static_cast<float>(oi_[k]);
+      wj_[4 * k + c] = static_cast<float>(oj_[k]);
+    }
+  for (SlotData& sl : slots_) {
+    std::fill(sl.val, sl.val + nf, 0.0f);
+    std::fill(sl.dval, sl.dval + nf, 0.0f);
+  }
 }
 
 bool PatchMatcher::WindowInside(int s, int t) const {
@@ -98,105 +120,56 @@ bool PatchMatcher::PrepareView(int v, int slot_index) {
   const double u0 = s_ + 0.5 - half_, v0 = t_ + 0.5 - half_;
   const Eigen::Vector3d base = A * Eigen::Vector3d(u0, v0, 1.0);
   const Eigen::Vector3d cu = A.col(0), cv = A.col(1);
+  mpgc_kernels::WindowRays& r = sl.rays;
   int idx = 0;
   for (int j = 0; j < n_; ++j) {
     const Eigen::Vector3d row = base + j * cv;
     for (int i = 0; i < n_; ++i, ++idx) {
       const double w = inv_norm_[idx];
-      sl.a[idx][0] = (row.x() + i * cu.x()) * w;
-      sl.a[idx][1] = (row.y() + i * cu.y()) * w;
-      sl.a[idx][2] = (row.z() + i * cu.z()) * w;
+      r.ax[idx] = (row.x() + i * cu.x()) * w;
+      r.ay[idx] = (row.y() + i * cu.y()) * w;
+      r.az[idx] = (row.z() + i * cu.z()) * w;
     }
+  }
+  for (int k = npix_; k < mpgc_kernels::kWindowPixels; ++k) {
+    r.ax[k] = r.ax[0];
+    r.ay[k] = r.ay[0];
+    r.az[k] = r.az[0];
   }
   return true;
 }
 
-// Samples view slot at the current (h, hs, ht); false when any window pixel
-// falls outside the image or behind the camera. C = channels, G = with the
-// derivative along the ray.
-template <int C, bool G>
-bool PatchMatcher::SampleSlotT(int slot_index) {
+// Samples view slot at the current (h, hs, ht) (mpgc_kernels.h); false when
+// any window pixel falls outside the image or behind the camera.
+bool PatchMatcher::SampleSlot(int slot_index, bool with_gradient) {
   SlotData& sl = slots_[slot_index];
   const PatchView& pv = ctx_.views[sl.view];
-  const MatchImage& im = pv.image;
-  const float* data = im.data;
-  const int w = im.width;
-  const double xmax = im.width - 0.5, ymax = im.height - 0.5;
-  const int x0max = im.width - 2, y0max = im.height - 2;
-  const double b0 = pv.b.x(), b1 = pv.b.y(), b2 = pv.b.z();
-  const int npix = npix_;
-  float* val = sl.val;
-  float* dval = sl.dval;
-  int idx = 0;
-  for (int j = -half_; j <= half_; ++j) {
-    const double hrow = h_ + j * ht_;
-    for (int i = -half_; i <= half_; ++i, ++idx) {
-      const double hh = hrow + i * hs_;
-      const double* a = sl.a[idx];
-      const double q2 = b2 + hh * a[2];
-      if (!(q2 > 1e-12)) return false;
-      const double inv = 1.0 / q2;
-      const double x = (b0 + hh * a[0]) * inv;
-      const double y = (b1 + hh * a[1]) * inv;
-      if (!(x >= 0.5 && y >= 0.5 && x < xmax && y < ymax)) return false;
-      const double fxd = x - 0.5, fyd = y - 0.5;
-      int x0 = static_cast<int>(fxd), y0 = static_cast<int>(fyd);
-      if (x0 > x0max) x0 = x0max;
-      if (y0 > y0max) y0 = y0max;
-      const float fx = static_cast<float>(fxd - x0),
-                  fy = static_cast<float>(fyd - y0);
-      const float* p00 = data + (static_cast<size_t>(y0) * w + x0) * C;
-      const float* p01 = p00 + static_cast<size_t>(w) * C;
-      float dx = 0, dy = 0;
-      if (G) {
-        dx = static_cast<float>((a[0] - x * a[2]) * inv);
-        dy = static_cast<float>((a[1] - y * a[2]) * inv);
-      }
-      for (int c = 0; c < C; ++c) {
-        const float v00 = p00[c], v10 = p00[C + c], v01 = p01[c],
-                    v11 = p01[C + c];
-        const float dtop = v10 - v00, dbot = v11 - v01;
-        const float top = v00 + fx * dtop, bot = v01 + fx * dbot;
-        val[c * npix + idx] = top + fy * (bot - top);
-        if (G) {
-          const float gx = dtop + fy * (dbot - dtop);
-          const float gy = bot - top;
-          dval[c * npix + idx] = gx * dx + gy * dy;
-        }
-      }
-    }
-  }
-  return true;
-}
-
-bool PatchMatcher::SampleSlot(int slot_index, bool with_gradient) {
-  if (channels_ == 3)
-    return with_gradient ? SampleSlotT<3, true>(slot_index)
-                         : SampleSlotT<3, false>(slot_index);
-  return with_gradient ? SampleSlotT<1, true>(slot_index)
-                       : SampleSlotT<1, false>(slot_index);
+  mpgc_kernels::SampleArgs a;
+  a.data = pv.image.data;
+  a.width = pv.image.width;
+  a.height = pv.image.height;
+  a.channels = pv.image.channels;
+  a.b[0] = pv.b.x();
+  a.b[1] = pv.b.y();
+  a.b[2] = pv.b.z();
+  a.rays = &sl.rays;
+  a.oi = oi_;
+  a.oj = oj_;
+  a.npix = npix_;
+  a.h = h_;
+  a.hs = hs_;
+  a.ht = ht_;
+  return mpgc_kernels::SampleWindow(a, sl.val,
+                                    with_gradient ? sl.dval : nullptr);
 }
 
 // NccChannels(ref_, val) with R's centred window and its sum of squares
 // precomputed in SetupPixel: sab = sum (r - mean_r) * v needs no mean of v.
 double PatchMatcher::SlotNcc(int slot_index) const {
-  const float* v = slots_[slot_index].val;
-  const int n = npix_;
   double sbb = 0, sab = 0;
-  for (int c = 0; c < channels_; ++c) {
-    const float* pv = v + c * n;
-    const float* pr = ref_centered_ + c * n;
-    double sb = 0, sbb_c = 0, sab_c = 0;
-    for (int i = 0; i < n; ++i) {
-      const double b = pv[i];
-      sb += b;
-      sbb_c += b * b;
-      sab_c += pr[i] * b;
-    }
-    sbb += sbb_c - sb * sb / n;
-    sab += sab_c;
-  }
-  const double m = static_cast<double>(n) * channels_;
+  mpgc_kernels::NccSums(ref_centered_, slots_[slot_index].val, mask_, npix_,
+                        &sbb, &sab);
+  const double m = static_cast<double>(npix_) * channels_;
   if (ref_saa_ < kNccMinVariance * m || sbb < kNccMinVariance * m) return -1;
   return sab / std::sqrt(ref_saa_ * sbb);
 }
@@ -207,16 +180,18 @@ void PatchMatcher::InitScales(int slot_index) {
   if (!mpgc_.optimize_color_scale) return;
   for (int c = 0; c < channels_; ++c) {
     double sv = 0, svv = 0;
-    const float* p = sl.val + c * npix_;
     for (int i = 0; i < npix_; ++i) {
-      sv += p[i];
-      svv += static_cast<double>(p[i]) * p[i];
+      const double p = sl.val[4 * i + c];
+      sv += p;
+      svv += p * p;
     }
     if (mpgc_.photometric_offset) {
       // Contrast ratio of the mean-free windows.
       double saa = 0;
-      const float* r = ref_centered_ + c * npix_;
-      for (int i = 0; i < npix_; ++i) saa += static_cast<double>(r[i]) * r[i];
+      for (int i = 0; i < npix_; ++i) {
+        const double r = ref_centered_[4 * i + c];
+        saa += r * r;
+      }
       const double sbb = svv - sv * sv / npix_;
       if (sbb > 1e-12 && saa > 1e-12)
         sl.scale[c] = static_cast<float>(std::sqrt(saa / sbb));
@@ -291,7 +266,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
       const double x = (s - half_ + i + 0.5 - cam.cx) / cam.fx;
       inv_norm_[idx] = 1.0 / std::sqrt(x * x + y * y + 1.0);
       for (int c = 0; c < channels_; ++c) {
-        ref_[c * npix_ + idx] = row[i * channels_ + c];
+        ref_[4 * idx + c] = row[i * channels_ + c];
         ref_sum_[c] += row[i * channels_ + c];
       }
     }
@@ -301,9 +276,9 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
     const double mean = ref_sum_[c] / npix_;
     double var_c = 0;
     for (int i = 0; i < npix_; ++i) {
-      const double d = ref_[c * npix_ + i] - mean;
+      const double d = ref_[4 * i + c] - mean;
       const float df = static_cast<float>(d);
-      ref_centered_[c * npix_ + i] = df;
+      ref_centered_[4 * i + c] = df;
       var_c += d * d;
       ref_saa_ += static_cast<double>(df) * df;
     }
@@ -405,26 +380,13 @@ bool PatchMatcher::DepthStep() {
   double q2 = 0, qe = 0;
   for (int a = 0; a < num_active_; ++a) {
     const SlotData& sl = slots_[active_slot_[a]];
+    mpgc_kernels::ChannelSums cs[4];
+    mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
+                             npix_, mpgc_.photometric_offset,
+                             /*depth_only=*/true, cs);
     for (int c = 0; c < channels_; ++c) {
-      const float* val = sl.val + c * npix_;
-      const float* dv = sl.dval + c * npix_;
-      const float* rv = ref_ + c * npix_;
-      const float sc = sl.scale[c];
-      float r_q2 = 0, r_qe = 0, r_q = 0, r_e = 0;
-      for (int idx = 0; idx < npix_; ++idx) {
-        const float q = sc * dv[idx];
-        const float e = rv[idx] - sc * val[idx];
-        r_q2 += q * q;
-        r_qe += q * e;
-        r_q += q;
-        r_e += e;
-      }
-      q2 += r_q2;
-      qe += r_qe;
-      if (mpgc_.photometric_offset) {  // the offset at its optimum
-        q2 -= static_cast<double>(r_q) * r_q / npix_;
-        qe -= static_cast<double>(r_q) * r_e / npix_;
-      }
+      q2 += cs[c].h[0];
+      qe += cs[c].g[0];
     }
   }
   if (!(q2 > 1e-20)) return false;
@@ -444,77 +406,25 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
   Eigen::Vector3d sij[kMaxActive][3];
   for (int a = 0; a < num_active_; ++a) {
     const SlotData& sl = slots_[active_slot_[a]];
+    // With the photometric offset (I_R = c I_V + b) the offset b per view
+    // and channel is eliminated at its optimum: every term is taken about
+    // its window mean (the kernel's `center`).
+    mpgc_kernels::ChannelSums cs[4];
+    mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
+                             npix_, mpgc_.photometric_offset,
+                             /*depth_only=*/false, cs);
     for (int c = 0; c < channels_; ++c) {
-      const float* val = sl.val + c * npix_;
-      const float* dv = sl.dval + c * npix_;
-      const float* rv = ref_ + c * npix_;
-      const double sc = sl.scale[c];
-      double q2 = 0, q2i = 0, q2j = 0, q2ii = 0, q2ij = 0, q2jj = 0;
-      double qe = 0, qei = 0, qej = 0, ii = 0, ie = 0, iq = 0, iqi = 0, iqj = 0;
-      double sq = 0, sqi = 0, sqj = 0, si = 0, se = 0;  // for the offset
-      int idx = 0;
-      for (int j = -half_; j <= half_; ++j) {
-        double r_q2 = 0, r_q2i = 0, r_q2ii = 0, r_qe = 0, r_qei = 0, r_iq = 0,
-               r_iqi = 0, r_q = 0, r_qi = 0;
-        for (int i = -half_; i <= half_; ++i, ++idx) {
-          const double I = val[idx];
-          const double q = sc * dv[idx];
-          const double e = rv[idx] - sc * I;
-          const double qq = q * q;
-          r_q2 += qq;
-          r_q2i += qq * i;
-          r_q2ii += qq * i * i;
-          r_qe += q * e;
-          r_qei += q * e * i;
-          r_iq += I * q;
-          r_iqi += I * q * i;
-          ii += I * I;
-          ie += I * e;
-          r_q += q;
-          r_qi += q * i;
-          si += I;
-          se += e;
-        }
-        sq += r_q;
-        sqi += r_qi;
-        sqj += r_q * j;
-        q2 += r_q2;
-        q2i += r_q2i;
-        q2j += r_q2 * j;
-        q2ii += r_q2ii;
-        q2ij += r_q2i * j;
-        q2jj += r_q2 * j * j;
-        qe += r_qe;
-        qei += r_qei;
-        qej += r_qe * j;
-        iq += r_iq;
-        iqi += r_iqi;
-        iqj += r_iq * j;
-      }
-      Eigen::Matrix3d Hc;
-      Hc << q2, q2i, q2j, q2i, q2ii, q2ij, q2j, q2ij, q2jj;
-      Eigen::Vector3d gc(qe, qei, qej), ic(iq, iqi, iqj);
-      if (mpgc_.photometric_offset) {
-        // I_R = c I_V + b: the offset b per view and channel eliminated at
-        // its optimum, i.e. every term taken about its window mean.
-        const double inv_n = 1.0 / npix_;
-        const Eigen::Vector3d m(sq * inv_n, sqi * inv_n, sqj * inv_n);
-        Hc -= npix_ * m * m.transpose();
-        gc -= m * se;
-        ic -= m * si;
-        ii -= si * si * inv_n;
-        ie -= si * se * inv_n;
-      }
-      H(0, 0) += Hc(0, 0);
-      H(0, 1) += Hc(0, 1);
-      H(0, 2) += Hc(0, 2);
-      H(1, 1) += Hc(1, 1);
-      H(1, 2) += Hc(1, 2);
-      H(2, 2) += Hc(2, 2);
-      g += gc;
-      sii[a][c] = ii;
-      sie[a][c] = ie;
-      sij[a][c] = ic;
+      const double* h = cs[c].h;
+      H(0, 0) += h[0];
+      H(0, 1) += h[1];
+      H(0, 2) += h[2];
+      H(1, 1) += h[3];
+      H(1, 2) += h[4];
+      H(2, 2) += h[5];
+      g += Eigen::Vector3d(cs[c].g[0], cs[c].g[1], cs[c].g[2]);
+      sii[a][c] = cs[c].ii;
+      sie[a][c] = cs[c].ie;
+      sij[a][c] = Eigen::Vector3d(cs[c].ic[0], cs[c].ic[1], cs[c].ic[2]);
     }
   }
   H(1, 0) = H(0, 1);

@@ -87,7 +87,10 @@ TEST(MpgcSchedule, FullUpdateEveryFifthIterationAndFailureAfterMax) {
   mo.max_iterations = 9;
   PatchMatcher m(ctx, mo, LocalViewSelectionOptions());
   MatchTrace tr;
-  EXPECT_FALSE(m.Match(x, y, s.depth[ref].at<float>(y, x) * 1.03,
+  // Started 5 % off: from 3 % the float NCC sums of the SIMD kernels
+  // (mpgc_kernels.h) repeat exactly between two iterations, which is
+  // convergence even for eps = 1e-300.
+  EXPECT_FALSE(m.Match(x, y, s.depth[ref].at<float>(y, x) * 1.05,
                        Eigen::Vector3d(0, 0, -1), nullptr, &tr));
   int full = 0, depth_only = 0;
   for (const auto& e : tr.events) {

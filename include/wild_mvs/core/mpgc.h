@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "wild_mvs/core/local_view_selection.h"
+#include "wild_mvs/core/mpgc_kernels.h"
 #include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/patch.h"
 
@@ -123,8 +124,6 @@ class PatchMatcher {
   bool SetupPixel(int s, int t, double depth, const Eigen::Vector3d& normal);
   bool PrepareView(int v, int slot_index);
   bool SampleSlot(int slot_index, bool with_gradient);
-  template <int C, bool G>
-  bool SampleSlotT(int slot_index);
   double SlotNcc(int slot_index) const;
   void InitScales(int slot_index);
   int FreeSlot() const;
@@ -158,10 +157,17 @@ class PatchMatcher {
   int s_ = 0, t_ = 0;
   double h_ = 0, hs_ = 0, ht_ = 0;
   double inv_norm_[kMaxWindowPixels];  // 1 / |K^-1 (u, v, 1)|
-  float ref_[3 * kMaxWindowPixels];    // planar: channel c at c * npix
+  // Window buffers in the kernels' layout (mpgc_kernels.h): pixel k,
+  // channel c at 4 k + c; unused lanes zero.
+  alignas(64) float ref_[mpgc_kernels::kWindowFloats];
   double ref_sum_[3];
-  float ref_centered_[3 * kMaxWindowPixels];  // ref_ minus its channel mean
-  double ref_saa_ = 0;                        // sum of squares of the above
+  alignas(64) float ref_centered_[mpgc_kernels::kWindowFloats];  // minus mean
+  alignas(64) float mask_[mpgc_kernels::kWindowFloats];  // 1 = pixel, channel
+  alignas(64) float wi_[mpgc_kernels::kWindowFloats];    // column offset i
+  alignas(64) float wj_[mpgc_kernels::kWindowFloats];    // row offset j
+  alignas(64) double oi_[mpgc_kernels::kWindowPixels];   // i per pixel
+  alignas(64) double oj_[mpgc_kernels::kWindowPixels];   // j per pixel
+  double ref_saa_ = 0;  // sum of squares of the above
   // Candidate state this visit: 0 free, 1 active, 2 rejected.
   uint8_t state_[kMaxNeighbors];
   Eigen::Vector2d epi_dir_[kMaxNeighbors];
@@ -173,9 +179,9 @@ class PatchMatcher {
   int iteration_ = 0;            // updates done in this call
   struct SlotData {
     int view = -1;
-    double a[kMaxWindowPixels][3];     // A_V (u, v, 1) / |K^-1 (u, v, 1)|
-    float val[3 * kMaxWindowPixels];   // planar samples
-    float dval[3 * kMaxWindowPixels];  // d sample / d h (along the ray)
+    mpgc_kernels::WindowRays rays;  // A_V (u, v, 1) / |K^-1 (u, v, 1)|
+    alignas(64) float val[mpgc_kernels::kWindowFloats];   // samples
+    alignas(64) float dval[mpgc_kernels::kWindowFloats];  // d sample / d h
     float scale[3];
     double ncc, prev_ncc;
   };
