@@ -17,16 +17,17 @@ namespace wild_mvs {
 // (View::file_width/height, else the camera's), resizes it to the camera
 // (area averaging) and converts it with ToLinearRgb. Throws Error naming
 // the file and the problem (missing, unreadable, wrong size).
-// A JPEG at least twice the camera's size (a downscaled view, e.g. a 24 MP
-// photo and --max-image-size 2000) is decoded reduced by libjpeg
-// (JpegReductionFactor), then resized by the exact remaining factor, so the
-// camera stays exact.
+// A JPEG at least four times the camera's size (a downscaled view, e.g. a
+// 24 MP photo and --max-image-size 1000) is decoded reduced by libjpeg
+// (JpegReductionFactor), then resized by the exact remaining factor (2x or
+// more, area averaging), so the camera stays exact.
 cv::Mat LoadViewImage(const View& view, const ImageOptions& options);
 
 // The reduction factor of the JPEG decode of a file_width x file_height
 // image for a camera of width x height: the largest of 8, 4, 2 with
-// file size >= factor x camera size on both axes (the decoded image,
-// ceil(file size / factor), holds at least the camera's resolution), else 1.
+// file size >= 2 x factor x camera size on both axes (the decoded image,
+// ceil(file size / factor), holds at least twice the camera's resolution:
+// the area-averaged resize after it keeps the full decode's quality), else 1.
 int JpegReductionFactor(int file_width, int file_height, int width, int height);
 
 // The view's image file as decoded, before undistortion and resizing: a JPEG
