@@ -183,34 +183,24 @@ bool LiveParams::OnSet(dynamic_reconfigure::Reconfigure::Request& req,
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> saved;
   for (const Option* o : options_) saved.push_back(o->Text());
-  auto find = [this](const std::string& name) -> Option* {
-    for (Option* o : options_)
-      if (ParamName(o->key()) == name) return o;
-    return nullptr;
+  // Sets the offered option of each requested parameter (a name that is
+  // not offered is refused: a typo must not pass).
+  auto set_all = [this](const auto& params, auto set) {
+    for (const auto& p : params) {
+      Option* found = nullptr;
+      for (Option* o : options_)
+        if (ParamName(o->key()) == p.name) found = o;
+      Require(found, "'", p.name, "' is not a live parameter");
+      set(found, p.value);
+    }
   };
   std::string problem;
   try {
-    // Names that are not offered are refused (a typo must not pass).
-    for (const auto& p : req.config.bools) {
-      Option* o = find(p.name);
-      Require(o, "'", p.name, "' is not a live parameter");
-      o->SetBool(p.value);
-    }
-    for (const auto& p : req.config.ints) {
-      Option* o = find(p.name);
-      Require(o, "'", p.name, "' is not a live parameter");
-      o->SetInt(p.value);
-    }
-    for (const auto& p : req.config.doubles) {
-      Option* o = find(p.name);
-      Require(o, "'", p.name, "' is not a live parameter");
-      o->SetDouble(p.value);
-    }
-    for (const auto& p : req.config.strs) {
-      Option* o = find(p.name);
-      Require(o, "'", p.name, "' is not a live parameter");
-      o->SetString(p.value);
-    }
+    set_all(req.config.bools, [](Option* o, bool v) { o->SetBool(v); });
+    set_all(req.config.ints, [](Option* o, int v) { o->SetInt(v); });
+    set_all(req.config.doubles, [](Option* o, double v) { o->SetDouble(v); });
+    set_all(req.config.strs,
+            [](Option* o, const std::string& v) { o->SetString(v); });
     apply_();  // Check() of the whole struct, then handed to the node
   } catch (const Error& e) {
     problem = e.what();

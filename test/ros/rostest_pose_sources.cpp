@@ -172,17 +172,10 @@ TEST(PoseSources, OdometryTransformAndPoseWithCovarianceAreInterpolated) {
       sensor_msgs::CameraInfo info = ros1::CameraInfoFromCamera(cam);
       info.header.stamp = ros::Time(kT0 + ti);
       info.header.frame_id = "camera_optical_frame";
-      const cv::Mat rgb = ros1::LinearToSrgb8(scene.images[next_image]);
-      sensor_msgs::Image im;
+      sensor_msgs::Image im =
+          ros1::MatToMsg(ros1::LinearToSrgb8(scene.images[next_image]),
+                         sensor_msgs::image_encodings::RGB8);
       im.header = info.header;
-      im.width = rgb.cols;
-      im.height = rgb.rows;
-      im.encoding = sensor_msgs::image_encodings::RGB8;
-      im.step = rgb.cols * 3;
-      im.data.resize(static_cast<size_t>(im.step) * im.height);
-      for (int r = 0; r < rgb.rows; ++r)
-        std::memcpy(&im.data[static_cast<size_t>(r) * im.step], rgb.ptr(r),
-                    im.step);
       info_pub.publish(info);
       image_pub.publish(im);
       ++next_image;
