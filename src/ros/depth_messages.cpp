@@ -102,30 +102,12 @@ std::vector<StreamReconstructor::StampedPoint> StampedPointsFromMsg(
   return pts;
 }
 
-RateStatus::RateStatus(const std::string& name, double min_hz, double max_hz,
-                       int window, unsigned char quiet_level,
-                       std::string quiet_message)
-    : std::pair<double, double>(min_hz, max_hz),
-      diagnostic_updater::FrequencyStatus(
-          diagnostic_updater::FrequencyStatusParam(&first, &second, 0.1,
-                                                   window),
-          name),
-      quiet_level_(quiet_level),
-      quiet_message_(std::move(quiet_message)) {}
-
-void RateStatus::run(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  diagnostic_updater::FrequencyStatus::run(stat);
-  // FrequencyStatus says ERROR only for a window without events.
-  if (stat.level == diagnostic_msgs::DiagnosticStatus::ERROR)
-    stat.summary(quiet_level_, quiet_message_);
-}
-
 void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
                           const DropCounter& drops,
                           diagnostic_updater::DiagnosticStatusWrapper& stat) {
   // The level follows the recent window (WARN clears once drops stop); the
   // totals stay in the values.
-  const uint64_t dropped = drops.Total(), recent = drops.RecentTotal();
+  const uint64_t recent = drops.RecentTotal();
   if (recent > 0 || in.recent_evictions > 0) {
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
                   "%lu frames dropped and %lu keyframes evicted before "
@@ -154,11 +136,7 @@ void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
   stat.add("tracker MB", s.tracker_mb);
   stat.add("last seconds per depth map", s.last_seconds);
   stat.add("mean seconds per depth map", s.mean_seconds);
-  stat.add("frames dropped", dropped);
-  stat.add("frames dropped recently", recent);
-  stat.add("drop window s", drops.window());
-  for (const auto& [reason, n] : drops.Counts())
-    stat.add("dropped: " + reason, n);
+  AddDropValues(drops, "frames", stat);
 }
 
 }  // namespace ros1

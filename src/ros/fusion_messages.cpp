@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "wild_mvs/ros/conversions.h"
+#include "wild_mvs/ros/diagnostics.h"
 
 namespace wild_mvs {
 namespace ros1 {
@@ -38,7 +39,7 @@ FusionSessionOptions SessionOptions(const FusionNodeOptions& o) {
 void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
                            size_t queued, const DropCounter& drops,
                            diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  const uint64_t dropped = drops.Total(), recent = drops.RecentTotal();
+  const uint64_t recent = drops.RecentTotal();
   if (recent > 0)
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
                   "%lu depth views dropped in the last %.0f s",
@@ -59,11 +60,7 @@ void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
   stat.add("resets", s.resets);
   stat.add("depth sessions", s.sessions);
   stat.add("session clouds saved", s.session_saves);
-  stat.add("views dropped", dropped);
-  stat.add("views dropped recently", recent);
-  stat.add("drop window s", drops.window());
-  for (const auto& [reason, n] : drops.Counts())
-    stat.add("dropped: " + reason, n);
+  AddDropValues(drops, "views", stat);
 }
 
 }  // namespace ros1

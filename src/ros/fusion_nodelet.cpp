@@ -17,7 +17,7 @@
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/ros/bus_stats.h"
 #include "wild_mvs/ros/conversions.h"
-#include "wild_mvs/ros/depth_messages.h"
+#include "wild_mvs/ros/diagnostics.h"
 #include "wild_mvs/ros/fusion_messages.h"
 #include "wild_mvs/ros/params_ros.h"
 #include "wild_mvs/stream/cloud_file.h"

@@ -109,6 +109,22 @@ void StreamReconstructor::Reset() {
   last_stamp_ = -1;
 }
 
+namespace {
+
+// A frame's camera and its image (CV_32FC3 of the camera's size); throws
+// Error naming the frame.
+void CheckFrame(const std::string& frame_id, const Camera& camera,
+                const cv::Mat& image) {
+  camera.Validate("frame '" + frame_id + "'");
+  Require(image.type() == CV_32FC3, "frame '", frame_id,
+          "': image must be CV_32FC3");
+  Require(image.cols == camera.width && image.rows == camera.height, "frame '",
+          frame_id, "': image is ", image.cols, "x", image.rows,
+          " but its camera is ", camera.width, "x", camera.height);
+}
+
+}  // namespace
+
 StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     double stamp, const std::string& frame_id, const Camera& camera,
     const cv::Mat& image) {
@@ -123,12 +139,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     const cv::Mat& image) {
   // Checked before any state changes (the ImageFn path can only check the
   // image once the frame is admitted).
-  camera.Validate("frame '" + frame_id + "'");
-  Require(image.type() == CV_32FC3, "frame '", frame_id,
-          "': image must be CV_32FC3");
-  Require(image.cols == camera.width && image.rows == camera.height, "frame '",
-          frame_id, "': image is ", image.cols, "x", image.rows,
-          " but its camera is ", camera.width, "x", camera.height);
+  CheckFrame(frame_id, camera, image);
   return AddFrame(stamp_ns, frame_id, camera, [&image](Camera*, cv::Mat* out) {
     *out = image;
     return true;
@@ -181,12 +192,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
   Camera camera = pose_camera;
   cv::Mat image;
   if (!make_image(&camera, &image)) return FrameStatus::kDropped;
-  camera.Validate("frame '" + frame_id + "'");
-  Require(image.type() == CV_32FC3, "frame '", frame_id,
-          "': image must be CV_32FC3");
-  Require(image.cols == camera.width && image.rows == camera.height, "frame '",
-          frame_id, "': image is ", image.cols, "x", image.rows,
-          " but its camera is ", camera.width, "x", camera.height);
+  CheckFrame(frame_id, camera, image);
 
   KeyframePtr kf;
   std::vector<KeyframePtr> evicted;

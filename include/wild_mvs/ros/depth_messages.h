@@ -5,7 +5,6 @@
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
-#include <diagnostic_updater/update_functions.h>
 #include <image_transport/image_transport.h>
 #include <ros/node_handle.h>
 #include <ros/publisher.h>
@@ -17,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "wild_mvs/ros/diagnostics.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
 
@@ -54,23 +54,6 @@ std::vector<StreamReconstructor::StampedPoint> StampedPointsFromMsg(
 
 // The depth node's diagnostics: the stream's statistics, the input queue
 // and the drops by reason.
-// A diagnostic_updater::FrequencyStatus (the event rate over the last
-// `window` diagnostics updates, judged against [min_hz, max_hz]; 0 and inf
-// = not judged) that reports a window without events as `quiet_level` with
-// `quiet_message` instead of ERROR: no depth map for a while is normal when
-// no new keyframe came.
-class RateStatus : private std::pair<double, double>,
-                   public diagnostic_updater::FrequencyStatus {
- public:
-  RateStatus(const std::string& name, double min_hz, double max_hz, int window,
-             unsigned char quiet_level, std::string quiet_message);
-  void run(diagnostic_updater::DiagnosticStatusWrapper& stat) override;
-
- private:
-  unsigned char quiet_level_;
-  std::string quiet_message_;
-};
-
 struct DepthInputStats {
   uint64_t received = 0;          // frames received
   size_t queued = 0;              // input queue length

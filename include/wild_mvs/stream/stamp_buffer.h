@@ -1,6 +1,6 @@
 // Copyright wild_mvs authors. Recent stamped inputs that a frame is paired
 // with (ROS-free): the depth node's camera_infos (by exact stamp, or the
-// latest) and poses (the nearest stamp within a tolerance). Stamps are
+// latest; the poses of a pose topic are in pose_track.h). Stamps are
 // integer nanoseconds. The Wait* calls wait up to a timeout of wall time
 // (steady clock, never the stream's clock, which may stand still) for a
 // matching item to arrive; Stop() wakes them for good.
@@ -10,7 +10,6 @@
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <map>
 #include <mutex>
 #include <utility>
@@ -88,81 +87,6 @@ class ExactStampBuffer {
   std::map<uint64_t, T> items_;
   T latest_{};
   bool have_latest_ = false;
-  bool stop_ = false;
-};
-
-// The last `capacity` items in arrival order, matched to a stamp by the
-// smallest time difference within a tolerance (a later arrival wins a tie).
-template <class T>
-class NearestStampBuffer {
- public:
-  explicit NearestStampBuffer(size_t capacity) : capacity_(capacity) {}
-
-  void Add(uint64_t stamp_ns, T item) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      items_.emplace_back(stamp_ns, std::move(item));
-      while (items_.size() > capacity_) items_.pop_front();
-    }
-    cv_.notify_all();
-  }
-
-  // |a - b| in seconds, computed as ROS does for a time difference
-  // (whole seconds plus nanoseconds).
-  static double Seconds(uint64_t a, uint64_t b) {
-    const int64_t d = static_cast<int64_t>(a) - static_cast<int64_t>(b);
-    int64_t sec = d / 1000000000, nsec = d % 1000000000;
-    if (nsec < 0) {
-      nsec += 1000000000;
-      --sec;
-    }
-    const double s =
-        static_cast<double>(sec) + 1e-9 * static_cast<double>(nsec);
-    return s < 0 ? -s : s;
-  }
-
-  // The item nearest to `stamp_ns` within `tolerance` s, waiting up to
-  // `timeout` s for one to arrive. False when there is none.
-  bool WaitNearest(uint64_t stamp_ns, double tolerance, double timeout,
-                   T* out) {
-    const auto deadline = stamp_buffer_detail::Deadline(timeout);
-    std::unique_lock<std::mutex> lock(mutex_);
-    for (;;) {
-      const std::pair<uint64_t, T>* best = nullptr;
-      double best_dt = tolerance;
-      for (const auto& item : items_) {
-        const double dt = Seconds(item.first, stamp_ns);
-        if (dt <= best_dt) {
-          best_dt = dt;
-          best = &item;
-        }
-      }
-      if (best) {
-        *out = best->second;
-        return true;
-      }
-      if (stop_) return false;
-      if (cv_.wait_until(lock, deadline) == std::cv_status::timeout)
-        return false;
-    }
-  }
-  void Stop() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    cv_.notify_all();
-  }
-  size_t size() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return items_.size();
-  }
-
- private:
-  const size_t capacity_;
-  mutable std::mutex mutex_;
-  std::condition_variable cv_;
-  std::deque<std::pair<uint64_t, T>> items_;
   bool stop_ = false;
 };
 
