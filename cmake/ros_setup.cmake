@@ -45,8 +45,8 @@ if(WILD_MVS_INSTALL_SETUP_FILES AND NOT CMAKE_INSTALL_PREFIX STREQUAL "/usr")
 endif()
 
 add_message_files(DIRECTORY msg FILES
-  DepthView.msg TrackedPoint.msg SparsePoints.msg)
-add_service_files(DIRECTORY srv FILES SaveCloud.srv)
+  DepthView.msg TrackedPoint.msg SparsePoints.msg SelectedKeyframe.msg KeyframeIndex.msg)
+add_service_files(DIRECTORY srv FILES SaveCloud.srv GetKeyframe.srv)
 generate_messages(DEPENDENCIES std_msgs sensor_msgs geometry_msgs)
 
 catkin_package(

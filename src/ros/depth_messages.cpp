@@ -118,6 +118,17 @@ void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
   } else {
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
   }
+  // (A lost keyframe is also a drop: WARN while recent.)
+  stat.add("role", in.role);
+  if (in.role == "selector") {
+    stat.add("keyframes published", in.keyframes_published);
+    stat.add("keyframes served", in.keyframes_served);
+  } else if (in.role == "worker") {
+    stat.add("keyframes received", in.keyframes_received);
+    stat.add("keyframes fetched", in.keyframes_fetched);
+    stat.add("keyframes lost", in.keyframes_lost);
+    stat.add("keyframe messages repeated", in.keyframes_repeated);
+  }
   stat.add("frames received", in.received);
   stat.add("input queue length", in.queued);
   stat.add("input queue size", in.queue_size);
@@ -127,6 +138,8 @@ void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
   stat.add("reconstructions pending", s.pending);
   stat.add("keyframes waiting", s.waiting);
   stat.add("depth maps", s.reconstructed);
+  stat.add("depth maps running", s.running);
+  stat.add("depth maps cancelled", s.cancelled);
   stat.add("depth maps redone", s.redone);
   stat.add("reconstructions failed", s.failed);
   stat.add("keyframes evicted before reconstruction", s.evicted_waiting);

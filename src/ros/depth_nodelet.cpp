@@ -13,8 +13,10 @@
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/ros/bus_stats.h"
+#include "wild_mvs/ros/conversions.h"
 #include "wild_mvs/ros/depth_inputs.h"
 #include "wild_mvs/ros/depth_messages.h"
+#include "wild_mvs/ros/keyframe_link.h"
 #include "wild_mvs/ros/live_params.h"
 #include "wild_mvs/ros/params_ros.h"
 #include "wild_mvs/stream/drop_counter.h"
@@ -51,6 +53,11 @@ struct DepthNode::Impl {
   std::atomic<uint64_t> evictions_reported{0};
   DropCounter evictions;         // throttles the warning below
   RoscppDropWatch roscpp_drops;  // roscpp's own queue drops, into `drops`
+  // Several workers: the selector's announcer, a worker's receiver.
+  std::unique_ptr<KeyframeAnnouncer> announcer;
+  std::unique_ptr<KeyframeReceiver> receiver;
+  ros::Subscriber keyframe_sub, index_sub;
+  ros::SteadyTimer index_timer;
 
   // Warns (throttled) when keyframes were evicted from the full keyframe
   // store before their depth map was made: reconstruction is slower than
@@ -91,16 +98,95 @@ struct DepthNode::Impl {
     }
   }
 
+  // The topic frames come from: `image` (or its compressed topic), a
+  // worker's `keyframes`.
+  std::string InputTopic() const {
+    if (receiver) return receiver->keyframes_topic();
+    return inputs->Topic("image") +
+           (options.image_transport == "raw" ? "" : "/compressed");
+  }
+
   void Enqueue(DepthFrame f) {
-    if (frame_rate) frame_rate->tick();
+    if (frame_rate && !f.index) frame_rate->tick();
     if (!queue->Push(std::move(f)))
-      Drop(inputs->Topic("image") +
-               (options.image_transport == "raw" ? "" : "/compressed"),
+      Drop(InputTopic(),
            "input queue full (frames arrive faster than they are processed)");
+  }
+
+  // Adds a frame whose camera (intrinsics and pose) is known to the stream;
+  // only a keyframe's image is converted.
+  StreamReconstructor::FrameStatus AddToStream(const DepthFrame& f,
+                                               const Camera& cam,
+                                               const std::string& topic) {
+    StreamReconstructor::FrameStatus status;
+    try {
+      status = stream->AddFrame(f.stamp.toNSec(), f.frame_id, cam,
+                                [this, &f](Camera* c, cv::Mat* image) {
+                                  return inputs->ConvertImage(f, c, image);
+                                });
+    } catch (const Error& e) {
+      Drop(topic, "rejected frame", e.what());
+      return StreamReconstructor::FrameStatus::kDropped;
+    }
+    ReportEvictions(stream->Stats().evicted_waiting);
+    switch (status) {
+      case StreamReconstructor::FrameStatus::kOutOfOrder:
+        Drop(topic, "stamp out of order (not after the previous frame)");
+        break;
+      case StreamReconstructor::FrameStatus::kReset:
+        ROS_WARN(
+            "%s: time or pose jump at stamp %.3f: keyframes and tracks "
+            "reset, starting again from this frame",
+            pnh.getNamespace().c_str(), f.stamp.toSec());
+        break;
+      default:
+        break;
+    }
+    return status;
+  }
+
+  // A worker: one keyframe of the selector (in id order, KeyframeReceiver).
+  void TakeKeyframe(const wild_mvs::SelectedKeyframeConstPtr& k) {
+    const std::string topic = receiver->keyframes_topic();
+    if (inputs->NoSlash(k->camera_pose.header.frame_id) !=
+        options.world_frame) {
+      Drop(topic, "camera_pose frame is not the world frame",
+           "'" + k->camera_pose.header.frame_id + "' vs '" +
+               options.world_frame + "'");
+      return;
+    }
+    DepthFrame f;
+    f.stamp = k->header.stamp;
+    f.frame_id = inputs->NoSlash(k->header.frame_id);
+    // The selector's messages, shared (no copy of the pixels).
+    if (!k->image.data.empty())
+      f.raw = sensor_msgs::ImageConstPtr(k, &k->image);
+    else if (!k->compressed.data.empty())
+      f.compressed = sensor_msgs::CompressedImageConstPtr(k, &k->compressed);
+    if (!f.raw && !f.compressed) {
+      Drop(topic, "keyframe without an image");
+      return;
+    }
+    f.info = sensor_msgs::CameraInfoConstPtr(k, &k->camera_info);
+    Camera cam;
+    if (!inputs->CameraFromInfo(f, &cam)) return;
+    try {
+      SetCameraPose(k->camera_pose.pose, &cam);
+    } catch (const Error& e) {
+      Drop(topic, "invalid camera_pose", e.what());
+      return;
+    }
+    // The selector's session, numbering and tracks.
+    stream->FollowSession(k->session.toNSec());
+    stream->SetNextKeyframeId(k->keyframe_id);
+    stream->SetSparsePoints(StampedPointsFromMsg(k->points));
+    AddToStream(f, cam, topic);
   }
 
   // The front end, one frame at a time.
   void Process(DepthFrame f) {
+    if (f.keyframe) return receiver->OnKeyframe(f.keyframe);
+    if (f.index) return receiver->OnIndex(f.index);
     const std::string image_topic = inputs->ImageTopic(f);
     if (!inputs->PairCameraInfo(&f)) return;
     if (stream->IsOutOfOrder(f.stamp.toNSec())) {
@@ -112,29 +198,14 @@ struct DepthNode::Impl {
     Camera cam;
     if (!inputs->CameraFromInfo(f, &cam) || !inputs->LookupPose(f, &cam))
       return;
-    StreamReconstructor::FrameStatus status;
-    try {
-      status = stream->AddFrame(f.stamp.toNSec(), f.frame_id, cam,
-                                [this, &f](Camera* c, cv::Mat* image) {
-                                  return inputs->ConvertImage(f, c, image);
-                                });
-    } catch (const Error& e) {
-      Drop(image_topic, "rejected frame", e.what());
-      return;
-    }
-    ReportEvictions(stream->Stats().evicted_waiting);
-    switch (status) {
-      case StreamReconstructor::FrameStatus::kOutOfOrder:
-        Drop(image_topic, "stamp out of order (not after the previous frame)");
-        return;
-      case StreamReconstructor::FrameStatus::kReset:
-        ROS_WARN(
-            "%s: time or pose jump at stamp %.3f: keyframes and tracks "
-            "reset, starting again from this frame",
-            pnh.getNamespace().c_str(), f.stamp.toSec());
-        break;
-      default:
-        break;
+    const StreamReconstructor::FrameStatus status =
+        AddToStream(f, cam, image_topic);
+    // A selector hands each new keyframe to the workers.
+    if (announcer && (status == StreamReconstructor::FrameStatus::kKeyframe ||
+                      status == StreamReconstructor::FrameStatus::kReset)) {
+      StreamReconstructor::KeyframeInfo info;
+      if (stream->Newest(&info) && info.stamp_ns == f.stamp.toNSec())
+        announcer->Publish(info, f, cam, stream->TrackedPoints());
     }
   }
 
@@ -142,7 +213,7 @@ struct DepthNode::Impl {
     try {
       Process(std::move(f));
     } catch (const std::exception& e) {
-      Drop(inputs->Topic("image"), "unexpected error", e.what());
+      Drop(InputTopic(), "unexpected error", e.what());
     }
   }
 
@@ -155,12 +226,27 @@ struct DepthNode::Impl {
   }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-    roscpp_drops.Update(inputs->QueueParams(), &drops);
+    std::map<std::string, std::string> queues = inputs->QueueParams();
+    if (keyframe_sub) queues[keyframe_sub.getTopic()] = "keyframe_queue_size";
+    roscpp_drops.Update(queues, &drops);
     const StreamStats s = stream->Stats();
     DepthInputStats in;
-    in.received = queue->received();
+    in.role = options.role;
+    if (announcer) {
+      in.keyframes_published = announcer->published();
+      in.keyframes_served = announcer->served();
+    }
+    if (receiver) {
+      const KeyframeReceiver::Stats r = receiver->stats();
+      in.keyframes_received = r.received;
+      in.keyframes_fetched = r.fetched;
+      in.keyframes_lost = r.lost;
+      in.keyframes_repeated = r.repeated;
+    }
+    // A worker's queue also carries the index messages: count keyframes.
+    in.received = receiver ? receiver->stats().received : queue->received();
     in.queued = queue->size();
-    in.queue_size = options.input_queue_size;
+    in.queue_size = static_cast<int>(queue->capacity());
     ReportEvictions(s.evicted_waiting);
     in.recent_evictions = evictions.RecentTotal();
     FillDepthDiagnostics(s, in, drops, stat);
@@ -211,13 +297,46 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       [&m](const std::string& e) {
         m.Drop("reconstruction", "keyframe failed", e);
       });
+  // A worker's queue holds keyframes (a few per second at most).
   m.queue = std::make_unique<WorkQueue<DepthFrame>>(
-      o.input_queue_size, [&m](DepthFrame f) { m.FrontEnd(std::move(f)); });
-  m.inputs->Subscribe(
-      [&m](DepthFrame f) { m.Enqueue(std::move(f)); },
-      [&m](std::vector<StreamReconstructor::StampedPoint> points) {
-        m.stream->SetSparsePoints(points);
-      });
+      o.role == "worker" ? o.keyframe_queue_size : o.input_queue_size,
+      [&m](DepthFrame f) { m.FrontEnd(std::move(f)); });
+  if (o.role == "worker") {
+    m.receiver = std::make_unique<KeyframeReceiver>(
+        m.nh, o.repair_delay,
+        [&m](const wild_mvs::SelectedKeyframeConstPtr& k) {
+          m.TakeKeyframe(k);
+        },
+        [&m](const std::string& topic, const std::string& problem,
+             const std::string& detail) { m.Drop(topic, problem, detail); });
+    m.keyframe_sub = m.nh.subscribe<wild_mvs::SelectedKeyframe>(
+        "keyframes", o.keyframe_queue_size,
+        [&m](const wild_mvs::SelectedKeyframeConstPtr& k) {
+          DepthFrame f;
+          f.keyframe = k;
+          f.stamp = k->header.stamp;
+          m.Enqueue(std::move(f));
+        });
+    m.index_sub = m.nh.subscribe<wild_mvs::KeyframeIndex>(
+        "keyframe_index", 10, [&m](const wild_mvs::KeyframeIndexConstPtr& k) {
+          DepthFrame f;
+          f.index = k;
+          m.Enqueue(std::move(f));
+        });
+  } else {
+    if (o.role == "selector") {
+      m.announcer = std::make_unique<KeyframeAnnouncer>(m.pnh, o.world_frame,
+                                                        o.keyframe_history);
+      m.index_timer = m.nh.createSteadyTimer(
+          ros::WallDuration(1.0),
+          [&m](const ros::SteadyTimerEvent&) { m.announcer->PublishIndex(); });
+    }
+    m.inputs->Subscribe(
+        [&m](DepthFrame f) { m.Enqueue(std::move(f)); },
+        [&m](std::vector<StreamReconstructor::StampedPoint> points) {
+          m.stream->SetSparsePoints(points);
+        });
+  }
 
   m.updater = std::make_unique<diagnostic_updater::Updater>(
       m.nh, m.pnh, m.pnh.getNamespace());
@@ -247,31 +366,51 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       });
   m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
   m.queue->Start();  // the front-end thread
-  ROS_INFO(
-      "%s: worker %d of %d, images %s (%s%s), camera_info %s (%s), pose "
-      "from %s, sparse points from %s, world frame '%s'",
-      pnh.getNamespace().c_str(), o.stream.worker_index, o.stream.worker_count,
-      m.inputs->image_topic().c_str(), o.image_transport.c_str(),
-      m.inputs->rectified() ? ", rectified" : "",
-      m.inputs->info_topic().c_str(),
-      o.camera_info_latest ? "latest" : "paired by stamp",
-      o.pose_source.c_str(), o.sparse_source.c_str(), o.world_frame.c_str());
+  if (o.role == "worker") {
+    ROS_INFO(
+        "%s: depth worker %d of %d, keyframes from %s (missed ones from %s), "
+        "world frame '%s'",
+        pnh.getNamespace().c_str(), o.stream.worker_index,
+        o.stream.worker_count, m.receiver->keyframes_topic().c_str(),
+        m.nh.resolveName("get_keyframe").c_str(), o.world_frame.c_str());
+  } else {
+    const std::string what = o.role == "selector"
+                                 ? std::string("keyframe selector (~keyframes)")
+                                 : Msg("worker ", o.stream.worker_index, " of ",
+                                       o.stream.worker_count);
+    ROS_INFO(
+        "%s: %s, images %s (%s%s), camera_info %s (%s), pose from %s, sparse "
+        "points from %s, world frame '%s'",
+        pnh.getNamespace().c_str(), what.c_str(),
+        m.inputs->image_topic().c_str(), o.image_transport.c_str(),
+        m.inputs->rectified() ? ", rectified" : "",
+        m.inputs->info_topic().c_str(),
+        o.camera_info_latest ? "latest" : "paired by stamp",
+        o.pose_source.c_str(), o.sparse_source.c_str(), o.world_frame.c_str());
+  }
 }
 
 DepthNode::~DepthNode() {
   Impl& m = *impl_;
   m.tick_timer.stop();
   m.diag_timer.stop();
+  m.index_timer.stop();
+  m.keyframe_sub.shutdown();
+  m.index_sub.shutdown();
   m.inputs->Stop();  // ends the waits, unsubscribes the images
   m.queue->Stop();   // joins the front end; frames still queued are dropped
+  // A running depth map is cancelled (it ends within a few pixels per
+  // tile: roslaunch escalates to SIGKILL 15 s after SIGINT).
+  m.stream->Shutdown();
   const StreamStats s = m.stream->Stats();
   std::fprintf(stderr,
                "depth node: %lu frames received, %lu keyframes, %lu depth "
-               "maps, %lu frames dropped, %lu keyframes evicted before a "
-               "depth map, %lu stream resets\n",
+               "maps (%lu cancelled at shutdown), %lu frames dropped, %lu "
+               "keyframes evicted before a depth map, %lu stream resets\n",
                static_cast<unsigned long>(m.queue->received()),
                static_cast<unsigned long>(s.keyframes_total),
                static_cast<unsigned long>(s.reconstructed),
+               static_cast<unsigned long>(s.cancelled),
                static_cast<unsigned long>(m.drops.Total()),
                static_cast<unsigned long>(s.evicted_waiting),
                static_cast<unsigned long>(s.resets));

@@ -2,6 +2,7 @@
 #include "wild_mvs/ros/fusion_messages.h"
 
 #include <chrono>
+#include <cstdio>
 
 #include "wild_mvs/ros/conversions.h"
 #include "wild_mvs/ros/diagnostics.h"
@@ -61,6 +62,41 @@ void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
   stat.add("depth sessions", s.sessions);
   stat.add("session clouds saved", s.session_saves);
   AddDropValues(drops, "views", stat);
+}
+
+std::string StampText(uint64_t stamp_ns) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%llu.%09llu",
+                static_cast<unsigned long long>(stamp_ns / 1000000000ull),
+                static_cast<unsigned long long>(stamp_ns % 1000000000ull));
+  return buf;
+}
+
+void AddKeyframeLedgerValues(
+    const KeyframeLedger::Report& r,
+    diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  auto list = [](const std::vector<KeyframeLedger::Key>& keys) {
+    std::string text;
+    for (const KeyframeLedger::Key& k : keys)
+      text += (text.empty() ? "" : " ") + StampText(k.second);
+    return text;
+  };
+  stat.add("keyframes announced", r.announced);
+  stat.add("keyframes with a depth view", r.done);
+  stat.add("keyframes missing", r.missing);
+  stat.add("keyframes done twice", r.twice);
+  if (r.missing > 0) {
+    stat.add("keyframes missing (first stamps)", list(r.missing_keys));
+    stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                       "%lu keyframes without a depth view",
+                       static_cast<unsigned long>(r.missing));
+  }
+  if (r.twice > 0) {
+    stat.add("keyframes done twice (first stamps)", list(r.twice_keys));
+    stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                       "%lu keyframes reconstructed twice",
+                       static_cast<unsigned long>(r.twice));
+  }
 }
 
 }  // namespace ros1

@@ -8,6 +8,7 @@
 #include <std_srvs/Trigger.h>
 #include <visualization_msgs/Marker.h>
 #include <wild_mvs/DepthView.h>
+#include <wild_mvs/KeyframeIndex.h>
 #include <wild_mvs/SaveCloud.h>
 
 #include <cstdio>
@@ -23,6 +24,7 @@
 #include "wild_mvs/stream/cloud_file.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/fusion_session.h"
+#include "wild_mvs/stream/keyframe_ledger.h"
 #include "wild_mvs/stream/periodic_worker.h"
 #include "wild_mvs/stream/work_queue.h"
 #if __has_include("wild_mvs/core/meshing.h")
@@ -55,6 +57,10 @@ struct FusionNode::Impl {
   std::unique_ptr<FusionSession> session;
   // Input queue (callback -> its fusion thread).
   std::unique_ptr<WorkQueue<wild_mvs::DepthViewConstPtr>> queue;
+  // Keyframes a selector announced (`keyframe_index`) and the depth views
+  // received for them: names missing and twice-done keyframes.
+  std::unique_ptr<KeyframeLedger> ledger;
+  ros::Subscriber index_sub;
   // Cloud versions sent (only touched inside FusionSession::CloudIfChanged).
   uint64_t published_version = 0, meshed_version = 0;
 
@@ -92,6 +98,16 @@ struct FusionNode::Impl {
       Drop("invalid depth_view", e.what());
       return;
     }
+    if (!ledger->Done(msg.session.toNSec(), msg.header.stamp.toNSec(),
+                      static_cast<int>(msg.revision)))
+      ROS_WARN_THROTTLE(options.error_throttle,
+                        "%s: keyframe %s (session %s) reconstructed twice, "
+                        "again by worker %u: two depth workers own it (the "
+                        "first result is kept; throttled)",
+                        pnh.getNamespace().c_str(),
+                        StampText(msg.header.stamp.toNSec()).c_str(),
+                        StampText(msg.session.toNSec()).c_str(),
+                        msg.worker_index);
     session->Add(std::move(view));
   }
 
@@ -189,6 +205,12 @@ struct FusionNode::Impl {
     const uint64_t received = queue->received();
     const size_t queued = queue->size();
     FillFusionDiagnostics(session->Stats(), received, queued, drops, stat);
+    AddKeyframeLedgerValues(ledger->Summarize(8), stat);
+  }
+
+  void OnIndex(const wild_mvs::KeyframeIndexConstPtr& msg) {
+    for (const ros::Time& t : msg->stamps)
+      ledger->Announce(msg->session.toNSec(), t.toNSec());
   }
 };
 
@@ -237,7 +259,9 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       "rate: depth views", 0.0, std::numeric_limits<double>::infinity(), 10,
       diagnostic_msgs::DiagnosticStatus::OK,
       "no depth view in the last 10 diagnostics periods");
+  m.ledger = std::make_unique<KeyframeLedger>(o.keyframes);
   m.sub = m.nh.subscribe("depth_view", o.input_queue_size, &Impl::OnView, &m);
+  m.index_sub = m.nh.subscribe("keyframe_index", 10, &Impl::OnIndex, &m);
   m.output_worker.Every(o.publish_period, [&m] { m.PublishCloud(false); });
   if (o.mesh_period > 0)
     m.mesh_worker.Every(o.mesh_period, [&m] { m.PublishMesh(); });
@@ -259,6 +283,7 @@ size_t FusionNode::Save(const std::string& path) { return impl_->Save(path); }
 FusionNode::~FusionNode() {
   Impl& m = *impl_;
   m.sub.shutdown();
+  m.index_sub.shutdown();
   m.diag_timer.stop();
   // A running mesh or publication finishes; nothing new starts.
   m.mesh_worker.Stop();

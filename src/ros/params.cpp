@@ -143,6 +143,16 @@ void DepthNodeOptions::Check() const {
   Require(
       std::isfinite(drop_window) && drop_window >= 0.1 && drop_window <= 86400,
       "drop_window = ", drop_window, " must be in [0.1, 86400] s");
+  Require(role == "standalone" || role == "selector" || role == "worker",
+          "role = '", role, "' must be 'standalone', 'selector' or 'worker'");
+  Require(keyframe_queue_size >= 1 && keyframe_queue_size <= 10000,
+          "keyframe_queue_size = ", keyframe_queue_size,
+          " must be in [1, 10000]");
+  Require(keyframe_history >= 1 && keyframe_history <= 10000,
+          "keyframe_history = ", keyframe_history, " must be in [1, 10000]");
+  Require(
+      std::isfinite(repair_delay) && repair_delay >= 0 && repair_delay <= 3600,
+      "repair_delay = ", repair_delay, " must be in [0, 3600] s");
   stream.Check();
 }
 
@@ -189,6 +199,7 @@ void FusionNodeOptions::Check() const {
           "on_new_session = '", on_new_session, "' must be 'keep' or 'reset'");
   Require(std::isfinite(map_store_mb) && map_store_mb > 0,
           "map_store_mb = ", map_store_mb, " must be > 0");
+  keyframes.Check();
   fusion.Check();
 }
 
@@ -292,6 +303,27 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "s, diagnostics WARN while drops happened within this window")
       .Min(0.1)
       .Max(86400);
+  registry
+      ->Add(key("role"), &o->role,
+            "standalone (select and reconstruct), selector (select, publish "
+            "~keyframes for workers), worker (keyframes from `keyframes`)")
+      .OneOf({"standalone", "selector", "worker"});
+  registry
+      ->Add(key("keyframe_queue_size"), &o->keyframe_queue_size,
+            "worker: roscpp queue of `keyframes`")
+      .Min(1)
+      .Max(10000);
+  registry
+      ->Add(key("keyframe_history"), &o->keyframe_history,
+            "selector: newest keyframes kept for ~get_keyframe")
+      .Min(1)
+      .Max(10000);
+  registry
+      ->Add(key("repair_delay"), &o->repair_delay,
+            "worker: s before an announced keyframe that did not arrive is "
+            "fetched from `get_keyframe`")
+      .Min(0)
+      .Max(3600);
   RegisterOptions(registry, prefix, &o->stream);
 }
 
@@ -350,6 +382,15 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "s, diagnostics WARN while drops happened within this window")
       .Min(0.1)
       .Max(86400);
+  registry
+      ->Add(key("keyframe_missing_after"), &o->keyframes.missing_after,
+            "s after a selector announced a keyframe (`keyframe_index`) "
+            "before it counts as missing without a depth view")
+      .Above(0);
+  registry
+      ->Add(key("keyframe_ledger_size"), &o->keyframes.max_keyframes,
+            "keyframes remembered for the missing / done-twice diagnostics")
+      .Min(1);
   // The core's fusion options, with the node's smaller memory budgets
   // (map_cache_mb 256, pending_mb 128; the CLI's are 512 and 256).
   RegisterOptions(registry, key("fusion"), &o->fusion);
@@ -360,7 +401,11 @@ DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params) {
   OptionRegistry registry;
   RegisterOptions(&registry, "", &o);
   ReadParams(params, &registry);
-  o.stream.use_tracker = o.sparse_source == "tracker";
+  // A worker's sparse points come with its keyframes; a selector
+  // reconstructs nothing.
+  o.stream.use_tracker = o.sparse_source == "tracker" && o.role != "worker";
+  o.stream.select_keyframes = o.role != "worker";
+  o.stream.reconstruct = o.role != "selector";
   CheckOptions(o, params);
   return o;
 }

@@ -10,6 +10,15 @@
 
 namespace wild_mvs {
 
+int KeyframeOwner(uint64_t stamp_ns, int worker_count) {
+  Require(worker_count >= 1, "worker_count = ", worker_count, " must be >= 1");
+  uint64_t z = stamp_ns + 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  z ^= z >> 31;
+  return static_cast<int>(z % static_cast<uint64_t>(worker_count));
+}
+
 size_t Keyframe::Bytes() const {
   return image.empty() ? 0 : image.total() * image.elemSize();
 }

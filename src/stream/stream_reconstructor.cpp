@@ -183,7 +183,8 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
       session_ = stamp;
       session_ns_ = stamp_ns;
     }
-    if (!store_.IsNewKeyframe(pose_camera, options_.keyframes))
+    if (options_.select_keyframes &&
+        !store_.IsNewKeyframe(pose_camera, options_.keyframes))
       return FrameStatus::kNotKeyframe;
     generation = generation_;
   }
@@ -217,8 +218,9 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
                  cv::INTER_AREA);
       kf->image_scale = double(kf->camera.width) / camera.width;
     }
-    kf->owned = static_cast<int>(kf->id % options_.worker_count) ==
-                options_.worker_index;
+    kf->owned =
+        options_.reconstruct &&
+        KeyframeOwner(stamp_ns, options_.worker_count) == options_.worker_index;
     evicted = store_.Add(kf);
     for (const KeyframePtr& e : evicted)
       if (!e->done() && !in_flight_.count(e->id)) ++stats_.evicted_waiting;
@@ -538,6 +540,53 @@ int StreamReconstructor::GoodNeighbors(uint32_t id) const {
   return 0;
 }
 
+bool StreamReconstructor::Newest(KeyframeInfo* info) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const KeyframePtr k = store_.Newest();
+  if (!k) return false;
+  info->id = k->id;
+  info->session_ns = session_ns_;
+  info->stamp_ns = k->stamp_ns;
+  return true;
+}
+
+std::vector<StreamReconstructor::StampedPoint>
+StreamReconstructor::TrackedPoints() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::unordered_map<uint32_t, KeyframePtr> held;
+  for (const KeyframePtr& k : store_.All()) held[k->id] = k;
+  std::vector<StampedPoint> out;
+  for (const SparsePoint& p : points_) {
+    StampedPoint q;
+    q.xyz = p.xyz;
+    for (const Observation& o : p.track) {
+      auto it = held.find(static_cast<uint32_t>(o.view));
+      if (it == held.end()) continue;
+      // Keyframe pixels back to the received image's (MakeSnapshotLocked
+      // scales them again).
+      q.observations.push_back(
+          {it->second->stamp, o.xy / it->second->image_scale});
+    }
+    if (q.observations.size() >= 2) out.push_back(std::move(q));
+  }
+  return out;
+}
+
+bool StreamReconstructor::FollowSession(uint64_t session_ns) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (session_ >= 0 && session_ns_ == session_ns) return false;
+  if (session_ >= 0 || store_.size() > 0) ClearLocked();
+  last_stamp_ = -1;
+  session_ns_ = session_ns;
+  session_ = StampSeconds(session_ns);
+  return true;
+}
+
+void StreamReconstructor::SetNextKeyframeId(uint32_t id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  next_id_ = std::max(next_id_, id);
+}
+
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      StreamOptions* o) {
   auto key = [&prefix](const char* name) {
@@ -592,8 +641,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(0);
   registry
       ->Add(key("worker_index"), &o->worker_index,
-            "several workers: this one reconstructs keyframes with index % "
-            "worker_count == worker_index")
+            "several workers: this one reconstructs the keyframes whose "
+            "stamp hashes to it (KeyframeOwner)")
       .Min(0)
       .Note("< worker_count");
   registry

@@ -83,10 +83,19 @@ has "$params" "/depth_node/world_frame: map" "live.launch world_frame"
 has "$params" "/fusion_node/world_frame: map" "live.launch world_frame (fusion)"
 has "$params" "/depth_node/image_transport: compressed" "live.launch transport"
 nodes=$(roslaunch --nodes wild_mvs workers.launch image:=/cam0/image_raw)
-for x in /depth_worker_0 /depth_worker_1 /fusion_node; do has "$nodes" "^$x\$" "workers.launch nodes"; done
-args=$(roslaunch --args /depth_worker_1 wild_mvs workers.launch image:=/cam0/image_raw)
+for x in /keyframe_selector /depth_worker_0 /depth_worker_1 /fusion_node; do has "$nodes" "^$x\$" "workers.launch nodes"; done
+args=$(roslaunch --args /keyframe_selector wild_mvs workers.launch image:=/cam0/image_raw)
 has "$args" "camera_info:=/cam0/camera_info" "workers.launch camera_info"
+args=$(roslaunch --args /depth_worker_1 wild_mvs workers.launch)
+has "$args" "keyframes:=/keyframe_selector/keyframes" "workers.launch worker keyframes"
+has "$args" "get_keyframe:=/keyframe_selector/get_keyframe" "workers.launch worker get_keyframe"
+args=$(roslaunch --args /fusion_node wild_mvs workers.launch)
+has "$args" "keyframe_index:=/keyframe_selector/keyframe_index" "workers.launch fusion keyframe_index"
+params=$(roslaunch --dump-params wild_mvs workers.launch world_frame:=map)
+has "$params" "/keyframe_selector/role: selector" "workers.launch selector role"
+has "$params" "/depth_worker_1/role: worker" "workers.launch worker role"
 params=$(roslaunch --dump-params wild_mvs depth_worker.launch index:=2 count:=3 world_frame:=odom)
 has "$params" "/depth_worker_2/worker_count: 3" "depth_worker.launch count"
 has "$params" "/depth_worker_2/world_frame: odom" "depth_worker.launch world_frame"
+has "$params" "/depth_worker_2/role: worker" "depth_worker.launch role"
 echo "PASS: $n launch checks"

@@ -2,7 +2,10 @@
 // depth node, on a synthetic stream with exact ground truth.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "ros_test_scene.h"
@@ -148,16 +151,132 @@ TEST(StreamReconstructor, EpochStampsPassThroughExactly) {
   }
 }
 
-TEST(StreamReconstructor, WorkersSplitKeyframesByIndex) {
+TEST(StreamReconstructor, KeyframeOwnerIsAnEvenHashOfTheStamp) {
+  // Deterministic, in range, and even over the stamps of a 30 Hz stream.
+  int counts[3] = {0, 0, 0};
+  const uint64_t t0 = 1700000000123456789ull;
+  for (int i = 0; i < 3000; ++i) {
+    const uint64_t stamp = t0 + uint64_t(i) * 33333333ull;
+    const int w = KeyframeOwner(stamp, 3);
+    ASSERT_GE(w, 0);
+    ASSERT_LT(w, 3);
+    EXPECT_EQ(w, KeyframeOwner(stamp, 3));
+    ++counts[w];
+  }
+  for (int c : counts) {
+    EXPECT_GT(c, 900);
+    EXPECT_LT(c, 1100);
+  }
+  EXPECT_EQ(KeyframeOwner(t0, 1), 0);
+  EXPECT_THROW(KeyframeOwner(t0, 0), Error);
+}
+
+// Three workers fed the same frames split the keyframes by the stamp hash:
+// every keyframe exactly once.
+TEST(StreamReconstructor, WorkersSplitKeyframesByStampHash) {
   const SyntheticScene& s = Scene6();
-  StreamOptions o = FastOptions();
-  o.worker_count = 3;
-  o.worker_index = 1;
-  Collector c;
-  StreamReconstructor stream(o, c.OnResult(), c.OnError());
-  Play(stream, s);
-  ASSERT_EQ(c.results.size(), 2u);  // keyframes 1 and 4
-  for (const StreamResult& r : c.results) EXPECT_EQ(r.keyframe_id % 3, 1u);
+  std::map<uint64_t, int> owner_of;
+  for (int w = 0; w < 3; ++w) {
+    StreamOptions o = FastOptions();
+    o.worker_count = 3;
+    o.worker_index = w;
+    Collector c;
+    StreamReconstructor stream(o, c.OnResult(), c.OnError());
+    Play(stream, s);
+    for (const StreamResult& r : c.results) {
+      EXPECT_EQ(KeyframeOwner(r.stamp_ns, 3), w);
+      EXPECT_TRUE(owner_of.emplace(r.stamp_ns, w).second)
+          << "stamp " << r.stamp_ns << " done twice";
+    }
+  }
+  EXPECT_EQ(owner_of.size(), 6u);  // none missing
+}
+
+// A worker fed by a selector (select_keyframes = false) keeps every frame
+// as a keyframe and owns the same keyframes whatever others it missed; a
+// selector (reconstruct = false) reconstructs nothing and hands out its
+// tracks by stamp.
+TEST(StreamReconstructor, SelectorAndWorkerRoles) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions so = FastOptions();
+  so.use_tracker = true;
+  so.reconstruct = false;
+  Collector sc;
+  StreamReconstructor selector(so, sc.OnResult(), sc.OnError());
+  std::vector<uint64_t> keyframe_stamps;
+  for (size_t i = 0; i < s.scene.views.size(); ++i) {
+    const auto st = selector.AddFrame(double(i), "camera",
+                                      s.scene.views[i].camera, s.images[i]);
+    if (st != StreamReconstructor::FrameStatus::kKeyframe) continue;
+    StreamReconstructor::KeyframeInfo info;
+    ASSERT_TRUE(selector.Newest(&info));
+    EXPECT_EQ(info.id, keyframe_stamps.size());
+    EXPECT_EQ(info.session_ns, 0u);
+    keyframe_stamps.push_back(info.stamp_ns);
+  }
+  selector.Tick();
+  selector.WaitIdle();
+  ASSERT_EQ(keyframe_stamps.size(), 6u);
+  EXPECT_TRUE(sc.results.empty());
+  EXPECT_EQ(selector.Stats().reconstructed, 0u);
+  const std::vector<StreamReconstructor::StampedPoint> tracked =
+      selector.TrackedPoints();
+  ASSERT_GT(tracked.size(), 100u);
+  for (const auto& p : tracked) {
+    ASSERT_GE(p.observations.size(), 2u);
+    for (const auto& o : p.observations) {
+      const int v = static_cast<int>(std::lround(o.stamp));
+      ASSERT_GE(v, 0);
+      ASSERT_LT(v, 6);
+      // The observation is where the point projects in that frame.
+      Eigen::Vector2d xy;
+      ASSERT_TRUE(s.scene.views[v].camera.Project(p.xyz, &xy));
+      EXPECT_LT((xy - o.xy).norm(), 3.0);
+    }
+  }
+
+  // Worker 0 of 2 misses the keyframes it does not own but one (as a
+  // worker that dropped messages would): it still owns, and reconstructs,
+  // exactly its share.
+  StreamOptions wo = FastOptions();
+  wo.select_keyframes = false;
+  wo.worker_count = 2;
+  wo.worker_index = 0;
+  Collector wc;
+  StreamReconstructor worker(wo, wc.OnResult(), wc.OnError());
+  EXPECT_TRUE(worker.FollowSession(0));
+  EXPECT_FALSE(worker.FollowSession(0));
+  worker.SetSparsePoints(StampedPoints(s));
+  std::set<uint64_t> mine;
+  bool skipped_one = false;
+  for (size_t i = 0; i < s.scene.views.size(); ++i) {
+    const uint64_t stamp = uint64_t(i) * 1000000000ull;
+    const bool owned = KeyframeOwner(stamp, 2) == 0;
+    if (owned) mine.insert(stamp);
+    if (!owned && !skipped_one) {
+      skipped_one = true;
+      continue;
+    }
+    // Every frame given is a keyframe (no selection thresholds).
+    EXPECT_EQ(
+        worker.AddFrame(stamp, "camera", s.scene.views[i].camera, s.images[i]),
+        StreamReconstructor::FrameStatus::kKeyframe);
+  }
+  ASSERT_TRUE(skipped_one);
+  for (int k = 0; k < 50 && worker.Stats().reconstructed < mine.size(); ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    worker.Tick();
+    worker.WaitIdle();
+  }
+  std::set<uint64_t> done;
+  for (const StreamResult& r : wc.results) {
+    done.insert(r.stamp_ns);
+    EXPECT_EQ(r.session_ns, 0u);
+  }
+  EXPECT_EQ(done, mine);
+  // A new session of the selector restarts the worker.
+  EXPECT_TRUE(worker.FollowSession(7000000000ull));
+  EXPECT_EQ(worker.Stats().keyframes, 0u);
 }
 
 TEST(StreamReconstructor, KeyframeSelectionOrderAndResets) {

@@ -18,6 +18,8 @@
 #include <sensor_msgs/Image.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include <wild_mvs/KeyframeIndex.h>
+#include <wild_mvs/SelectedKeyframe.h>
 #include <wild_mvs/SparsePoints.h>
 
 #include <Eigen/Geometry>
@@ -41,13 +43,16 @@
 namespace wild_mvs {
 namespace ros1 {
 
-// A received image (raw or compressed), before conversion.
+// A received image (raw or compressed), before conversion; for a worker
+// (~role worker) a keyframe message or a keyframe index instead.
 struct DepthFrame {
   sensor_msgs::ImageConstPtr raw;
   sensor_msgs::CompressedImageConstPtr compressed;
   sensor_msgs::CameraInfoConstPtr info;  // set by PairCameraInfo
   ros::Time stamp;
   std::string frame_id;
+  wild_mvs::SelectedKeyframeConstPtr keyframe;
+  wild_mvs::KeyframeIndexConstPtr index;
 };
 
 class DepthInputs {

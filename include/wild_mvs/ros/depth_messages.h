@@ -59,6 +59,13 @@ struct DepthInputStats {
   size_t queued = 0;              // input queue length
   int queue_size = 0;             // its bound
   uint64_t recent_evictions = 0;  // within the drop counter's window
+  // Several workers (~role): "standalone", "selector" or "worker"; the
+  // selector's keyframes published and served on ~get_keyframe, a worker's
+  // keyframes received, fetched and lost (KeyframeReceiver::Stats).
+  std::string role = "standalone";
+  uint64_t keyframes_published = 0, keyframes_served = 0;
+  uint64_t keyframes_received = 0, keyframes_fetched = 0;
+  uint64_t keyframes_lost = 0, keyframes_repeated = 0;
 };
 void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
                           const DropCounter& drops,

@@ -26,6 +26,7 @@
 
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/option_registry.h"
+#include "wild_mvs/stream/keyframe_ledger.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
 
 namespace wild_mvs {
@@ -137,7 +138,25 @@ struct DepthNodeOptions {
   // Diagnostics WARN while there were drops within the last drop_window s
   // (the totals are kept too).
   double drop_window = 60.0;
-  StreamOptions stream;  // keyframes, store, scheduling, core options
+  // The node's part when depth maps are spread over several workers
+  // (docs/ROS.md, "Several depth workers"):
+  //   "standalone": selects keyframes from `image` and reconstructs the
+  //   ones it owns (KeyframeOwner of worker_index / worker_count; all of
+  //   them with the default worker_count 1);
+  //   "selector": selects keyframes from `image` and tracks them, then
+  //   publishes each keyframe with its pose and the sparse tracks on
+  //   ~keyframes (and ~keyframe_index, ~get_keyframe); reconstructs none;
+  //   "worker": takes every keyframe from a selector's `keyframes` topic
+  //   (`image`, camera_info, pose and sparse_source are not used) and
+  //   reconstructs the ones it owns. A gap in the keyframe ids, or a
+  //   keyframe `keyframe_index` announced that has not arrived after
+  //   repair_delay, is fetched from the selector's `get_keyframe`.
+  std::string role = "standalone";
+  int keyframe_queue_size = 50;  // roscpp queue of `keyframes` (worker)
+  int keyframe_history = 40;     // keyframes a selector keeps for
+                                 // ~get_keyframe (the newest)
+  double repair_delay = 1.0;     // s, see role "worker"
+  StreamOptions stream;          // keyframes, store, scheduling, core options
   void Check() const;
 };
 
@@ -168,6 +187,10 @@ struct FusionNodeOptions {
   // redefined, e.g. a SLAM map reset). Views of an earlier session that
   // arrive late are fused ("keep") or dropped, counted ("reset").
   std::string on_new_session = "keep";
+  // A keyframe a selector announced (`keyframe_index`) without a depth view
+  // after this many seconds is named missing in diagnostics; a second
+  // first depth view of a keyframe is named done twice.
+  KeyframeLedgerOptions keyframes;
   // Depth maps held in memory for the consistency checks; older ones are
   // spilled to spill_dir (a temporary folder when empty) and read back when
   // needed, so memory stays bounded on long runs.

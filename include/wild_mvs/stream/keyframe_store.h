@@ -3,8 +3,10 @@
 //
 // A keyframe is an undistorted input image (CV_32FC3 linear RGB, the core's
 // image type) with its pinhole camera (world-to-camera pose, camera.h
-// conventions). Keyframes are numbered 0, 1, 2, ... in arrival order; the id
-// decides which depth worker owns a keyframe (id % worker_count).
+// conventions). Keyframes are numbered 0, 1, 2, ... in arrival order. The
+// depth worker that owns a keyframe follows from its stamp alone
+// (KeyframeOwner), so that workers agree on ownership whatever frames each
+// of them saw.
 //
 // The store is bounded by `max_keyframes` and `max_mb`. Beyond a bound it
 // evicts the least useful keyframe, never the newest:
@@ -45,6 +47,13 @@ struct Keyframe {
   size_t Bytes() const;
 };
 using KeyframePtr = std::shared_ptr<Keyframe>;
+
+// The depth worker (0 .. worker_count - 1) that reconstructs the keyframe
+// with this image stamp (ns): a 64-bit mix of the stamp (SplitMix64's
+// finaliser) modulo worker_count. It depends on the stamp only, never on
+// the order or number of frames a worker received; keyframes spread evenly
+// over the workers whatever the frame rate.
+int KeyframeOwner(uint64_t stamp_ns, int worker_count);
 
 struct KeyframeSelectionOptions {
   // A frame becomes a keyframe when its camera centre is at least this far

@@ -4,8 +4,11 @@
 // AddFrame() selects keyframes (baseline / viewing-angle thresholds), keeps
 // them in a bounded KeyframeStore, grows the sparse tracks (the incremental
 // tracker, or points given with SetSparsePoints), and schedules the
-// reconstruction of every keyframe this worker owns (id % worker_count ==
-// worker_index) once it has enough good neighbours. Reconstructions run on
+// reconstruction of every keyframe this worker owns
+// (KeyframeOwner(stamp, worker_count) == worker_index) once it has enough
+// good neighbours. With select_keyframes = false every frame given is a
+// keyframe (a depth worker fed by a keyframe selector); with reconstruct =
+// false nothing is reconstructed (the selector itself). Reconstructions run on
 // an internal worker pool: AddFrame never waits for them. A keyframe may be
 // redone later when its neighbourhood became clearly better
 // (redo_min_gain). Results are handed to the result callback on a worker
@@ -44,8 +47,11 @@ struct StreamOptions {
   // at a time on a dispatcher thread, never on the caller's thread.
   int num_threads = 2;   // config/depth_node.yaml shows the same
   int max_pending = 2;   // reconstructions queued or running; more wait
-  int worker_index = 0;  // this worker owns keyframes with
-  int worker_count = 1;  // id % worker_count == worker_index
+  int worker_index = 0;  // this worker owns the keyframes with
+  int worker_count = 1;  // KeyframeOwner(stamp, worker_count) == worker_index
+  // Set by the depth node's ~role (not parameters of their own):
+  bool select_keyframes = true;  // false: every frame is a keyframe
+  bool reconstruct = true;       // false: select and track only
   // Good neighbours of a keyframe = the views the core's global view
   // selection (mvs.global) picks for it over the store with a positive
   // score (shared sparse points, parallax and resolution weights).
@@ -207,6 +213,28 @@ class StreamReconstructor {
   // Good-neighbour count of keyframe `id` (tests).
   int GoodNeighbors(uint32_t id) const;
 
+  // The newest keyframe (a selector publishes it after AddFrame kept a
+  // frame): false when the store is empty.
+  struct KeyframeInfo {
+    uint32_t id = 0;
+    uint64_t session_ns = 0;  // see StreamResult::session
+    uint64_t stamp_ns = 0;
+  };
+  bool Newest(KeyframeInfo* info) const;
+  // The sparse tracks as stamped points (pixels in the received images'
+  // core convention), restricted to the keyframes held: what a selector
+  // hands its workers (SetSparsePoints).
+  std::vector<StampedPoint> TrackedPoints() const;
+  // Starts the session a keyframe selector announced (a worker follows
+  // the selector's sessions, so that its results carry the selector's
+  // session): when `session_ns` is not the current one, every keyframe and
+  // track is forgotten as by Reset() and the session is `session_ns`.
+  // Returns true when a new session started.
+  bool FollowSession(uint64_t session_ns);
+  // The id the next keyframe gets (a worker numbers its keyframes as the
+  // selector did); ignored unless larger than every id given so far.
+  void SetNextKeyframeId(uint32_t id);
+
  private:
   struct Neighborhood {
     int good = 0;
@@ -242,7 +270,7 @@ class StreamReconstructor {
   uint64_t generation_ = 0;
   bool idle_scheduled_ = false;
   std::atomic<bool> cancel_{false};  // set by Shutdown()
-  bool shut_down_ = false;    // the idle
+  bool shut_down_ = false;           // the idle
                                      // flush ran since the last keyframe
   double last_keyframe_wall_ = 0;    // steady clock, s
   double last_stamp_ = -1;
