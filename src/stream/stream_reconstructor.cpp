@@ -569,6 +569,21 @@ StreamReconstructor::TrackedPoints() const {
     }
     if (q.observations.size() >= 2) out.push_back(std::move(q));
   }
+  // Points given by stamp (SetSparsePoints), on the keyframes held.
+  std::vector<double> stamps;
+  for (const auto& [id, k] : held) stamps.push_back(k->stamp);
+  std::sort(stamps.begin(), stamps.end());
+  auto is_held = [&stamps](double s) {
+    auto it = std::lower_bound(stamps.begin(), stamps.end(), s - 1e-4);
+    return it != stamps.end() && std::abs(*it - s) <= 1e-4;
+  };
+  for (const StampedPoint& p : stamped_points_) {
+    StampedPoint q;
+    q.xyz = p.xyz;
+    for (const StampedObservation& o : p.observations)
+      if (is_held(o.stamp)) q.observations.push_back(o);
+    if (q.observations.size() >= 2) out.push_back(std::move(q));
+  }
   return out;
 }
 

@@ -235,6 +235,19 @@ TEST(StreamReconstructor, SelectorAndWorkerRoles) {
     }
   }
 
+  // Points given by stamp (a SLAM system's, sparse_source topic) are handed
+  // on the same way, restricted to the keyframes held.
+  StreamOptions to = so;
+  to.use_tracker = false;
+  StreamReconstructor topic_selector(to, sc.OnResult(), sc.OnError());
+  topic_selector.SetSparsePoints(StampedPoints(s));
+  for (size_t i = 0; i < s.scene.views.size(); ++i)
+    topic_selector.AddFrame(double(i), "camera", s.scene.views[i].camera,
+                            s.images[i]);
+  size_t with_two = 0;
+  for (const auto& p : StampedPoints(s)) with_two += p.observations.size() >= 2;
+  EXPECT_EQ(topic_selector.TrackedPoints().size(), with_two);
+
   // Worker 0 of 2 misses the keyframes it does not own but one (as a
   // worker that dropped messages would): it still owns, and reconstructs,
   // exactly its share.

@@ -221,9 +221,10 @@ class StreamReconstructor {
     uint64_t stamp_ns = 0;
   };
   bool Newest(KeyframeInfo* info) const;
-  // The sparse tracks as stamped points (pixels in the received images'
-  // core convention), restricted to the keyframes held: what a selector
-  // hands its workers (SetSparsePoints).
+  // The sparse points as stamped points (the tracker's, or those given
+  // with SetSparsePoints; pixels in the received images' core convention),
+  // restricted to the keyframes held: what a selector hands its workers
+  // (SetSparsePoints).
   std::vector<StampedPoint> TrackedPoints() const;
   // Starts the session a keyframe selector announced (a worker follows
   // the selector's sessions, so that its results carry the selector's
