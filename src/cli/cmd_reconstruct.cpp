@@ -341,8 +341,10 @@ void FuseAndMeshStages(const Scene& scene, ImageCache* images,
       log << "fuse: " << fused
           << " is up to date, skipped (--force recomputes)\n";
     } else {
-      r->fuse =
-          RunFuseStage(scene, images, config, pool, out, fused, log, &cloud);
+      // The mesh stage takes the cloud from memory; without it the cloud
+      // is only written (in chunks, no copy).
+      r->fuse = RunFuseStage(scene, images, config, pool, out, fused, log,
+                             config.run.HasStage("mesh") ? &cloud : nullptr);
       have_cloud = r->fused_now = true;
     }
   }

@@ -91,18 +91,27 @@ FuseResult RunFuseStage(const Scene& scene, ImageCache* images,
     progress.End("");
   }
   progress.Finish();
-  PointCloud cloud = fusion.Cloud();
+  // Only the cloud is left to use: the maps and pending samples go first,
+  // and without a caller that needs the cloud it is written in chunks
+  // rather than copied whole.
+  fusion.Finish();
   const FusionStats& st = fusion.stats();
-  WritePly(ply, cloud);
+  if (cloud_out) {
+    *cloud_out = fusion.Cloud();
+    WritePly(ply, *cloud_out);
+  } else {
+    WritePlyChunked(ply, fusion.num_points(), [&](size_t begin, size_t end) {
+      return fusion.Cloud(begin, end);
+    });
+  }
   FuseResult r;
   r.views = static_cast<int>(views.size());
-  r.points = cloud.size();
+  r.points = fusion.num_points();
   r.seconds = SecondsSince(t0);
   log << "fuse: " << r.views << " depth maps, " << st.samples << " samples, "
       << st.accepted << " consistent -> " << r.points << " points, peak "
       << st.peak_bytes / (1024 * 1024) << " MB, "
       << Progress::FormatDuration(r.seconds) << " -> " << ply << std::endl;
-  if (cloud_out) *cloud_out = std::move(cloud);
   return r;
 }
 

@@ -220,7 +220,7 @@ size_t StreamingFusion::PendingBytes() const {
 size_t StreamingFusion::CloudBytes() const {
   // Points, plus hash nodes (key, value, next pointer, cached hash) and
   // buckets.
-  return points_.capacity() * sizeof(Accum) +
+  return points_.bytes() +
          hash_.size() * (sizeof(uint64_t) * 2 + sizeof(void*) * 2) +
          hash_.bucket_count() * sizeof(void*);
 }
@@ -551,7 +551,18 @@ void StreamingFusion::TrimPending() {
   }
 }
 
+void StreamingFusion::Finish() {
+  finished_ = true;
+  lru_.clear();
+  lru_index_.clear();
+  lru_bytes_ = 0;
+  pending_.clear();
+  pending_count_ = 0;
+  UpdatePeak();
+}
+
 void StreamingFusion::AddView(int view) {
+  Require(!finished_, "fusion: view ", view, " added after Finish()");
   Require(!HasView(view), "fusion: view ", view, " was already added");
   std::shared_ptr<const Prepared> v = GetMap(view, true);
   const Prepared& V = *v;
@@ -697,15 +708,20 @@ void StreamingFusion::AddView(int view) {
   UpdatePeak();
 }
 
-PointCloud StreamingFusion::Cloud() const {
+PointCloud StreamingFusion::Cloud() const { return Cloud(0, points_.size()); }
+
+PointCloud StreamingFusion::Cloud(size_t begin, size_t end) const {
+  Require(begin <= end && end <= points_.size(), "fusion: points [", begin,
+          ", ", end, ") of ", points_.size());
   PointCloud pc;
-  const size_t n = points_.size();
+  const size_t n = end - begin;
   pc.xyz.reserve(n);
   pc.normal.reserve(n);
   if (image_) pc.rgb.reserve(n);
   pc.confidence.reserve(n);
   pc.support.reserve(n);
-  for (const Accum& a : points_) {
+  for (size_t k = begin; k < end; ++k) {
+    const Accum& a = points_[k];
     pc.xyz.push_back((a.sum_x / a.sum_w).cast<float>());
     Eigen::Vector3f nn = a.sum_n;
     const float len = nn.norm();

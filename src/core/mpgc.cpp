@@ -53,6 +53,13 @@ void MpgcOptions::Check() const {
   Require(normal_step_halvings >= 0 && normal_step_halvings <= 8,
           "mvs.mpgc.normal_step_halvings = ", normal_step_halvings,
           " must be in [0, 8]");
+  Require(forecast_iteration >= -1 && forecast_iteration < settle_iterations,
+          "mvs.mpgc.forecast_iteration = ", forecast_iteration,
+          " must be -1 (off) or in [0, mvs.mpgc.settle_iterations = ",
+          settle_iterations, ")");
+  Require(std::isfinite(forecast_margin) && forecast_margin >= 0 &&
+              forecast_margin <= 2,
+          "mvs.mpgc.forecast_margin = ", forecast_margin, " must be in [0, 2]");
   Require(min_active_views >= 1 && min_active_views <= kMaxActive,
           "mvs.mpgc.min_active_views = ", min_active_views, " must be in [1, ",
           kMaxActive, "]");
@@ -367,6 +374,23 @@ int PatchMatcher::TestActive(int it, bool* stable) {
   return dropped;
 }
 
+bool PatchMatcher::SettlingHopeless() {
+  int can_pass = 0;
+  const double bar = mpgc_.drop_ncc - mpgc_.forecast_margin;
+  for (int a = 0; a < num_active_; ++a)
+    can_pass += SlotNcc(active_slot_[a]) >= bar;
+  // The views not tried yet, until enough pass (a free slot; the state of
+  // the match is not changed).
+  const int nv = static_cast<int>(ctx_.views.size());
+  const int slot = FreeSlot();
+  for (int k = 0; k < nv && can_pass < mpgc_.min_active_views; ++k) {
+    if (state_[k] != 0) continue;
+    PrepareView(k, slot);
+    can_pass += SampleSlot(slot, false) && SlotNcc(slot) >= bar;
+  }
+  return can_pass < mpgc_.min_active_views;
+}
+
 int PatchMatcher::RefillActive() {
   const int first_new = num_active_;
   FillActive();
@@ -541,6 +565,10 @@ bool PatchMatcher::Match(int s, int t, double depth,
     int dropped = 0;
     bool stable = false;
     if (it >= mpgc_.settle_iterations) dropped = TestActive(it, &stable);
+    if (it == mpgc_.forecast_iteration && SettlingHopeless()) {
+      Note(it, MatchTrace::Kind::kForecastFailed, -1);
+      return false;
+    }
     if (left + dropped == 0 && stable && !changed &&
         num_active_ >= mpgc_.min_active_views) {
       Note(it, MatchTrace::Kind::kConverged, -1);
@@ -653,6 +681,17 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry->Add(key("photometric_offset"), &o->photometric_offset,
                 "photometric model I_R = c I_V + b (an offset per view and "
                 "channel); false = c I_V (paper)");
+  registry
+      ->Add(key("forecast_iteration"), &o->forecast_iteration,
+            "after this many updates fail a pixel whose views cannot pass "
+            "kappa at settling; -1 = off (paper)")
+      .Min(-1)
+      .Note("< settle_iterations");
+  registry
+      ->Add(key("forecast_margin"), &o->forecast_margin,
+            "NCC below kappa still counted as passing by forecast_iteration")
+      .Min(0)
+      .Max(2);
   registry->Add(key("optimize_normal"), &o->optimize_normal,
                 "optimise the normal; false = fronto-parallel (ablation)");
   registry->Add(key("optimize_color_scale"), &o->optimize_color_scale,

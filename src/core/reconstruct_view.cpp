@@ -33,6 +33,7 @@ MvsOptions PaperMvsOptions() {
   o.mpgc.accept_ncc = -1;
   o.mpgc.min_texture_levels = 0;
   o.mpgc.normal_step_halvings = 0;
+  o.mpgc.forecast_iteration = -1;
   o.mpgc.photometric_offset = false;
   o.growing.revisit_margin = 0;
   o.growing.hypotheses = 0;

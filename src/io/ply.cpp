@@ -34,15 +34,8 @@ void CheckCloud(const std::string& path, const PointCloud& c) {
           c.support.size(), " support values for ", n, " points");
 }
 
-void Write(const std::string& path, const PointCloud& c,
-           const std::vector<Eigen::Vector3i>* faces) {
-  CheckCloud(path, c);
-  const size_t n = c.size();
-  if (faces)
-    for (const auto& f : *faces)
-      Require(f.minCoeff() >= 0 && static_cast<size_t>(f.maxCoeff()) < n, path,
-              ": face (", f.transpose(), ") refers to a missing vertex (", n,
-              " vertices)");
+// The header of a binary PLY of n vertices with c's attributes (+ faces).
+std::string Header(size_t n, const PointCloud& c, const size_t* faces) {
   std::ostringstream h;
   h << "ply\nformat binary_little_endian 1.0\ncomment written by wild_mvs\n"
     << "element vertex " << n << "\n"
@@ -54,39 +47,58 @@ void Write(const std::string& path, const PointCloud& c,
   if (c.has_confidence()) h << "property float confidence\n";
   if (c.has_support()) h << "property ushort support\n";
   if (faces)
-    h << "element face " << faces->size() << "\n"
+    h << "element face " << *faces << "\n"
       << "property list uchar int vertex_indices\n";
   h << "end_header\n";
+  return h.str();
+}
+
+constexpr size_t kFlushBytes = size_t{1} << 21;
+
+// Appends c's vertices to buf, writing buf to os whenever it exceeds
+// kFlushBytes.
+void PutVertices(const PointCloud& c, std::string* buf, std::ostream& os) {
+  for (size_t i = 0; i < c.size(); ++i) {
+    for (int k = 0; k < 3; ++k) Put<float>(buf, c.xyz[i][k]);
+    if (c.has_normal())
+      for (int k = 0; k < 3; ++k) Put<float>(buf, c.normal[i][k]);
+    if (c.has_rgb())
+      for (int k = 0; k < 3; ++k) {
+        const float v = c.rgb[i][k];
+        Put<uint8_t>(
+            buf, static_cast<uint8_t>(std::lround(
+                     std::clamp(std::isfinite(v) ? v : 0.f, 0.f, 1.f) * 255)));
+      }
+    if (c.has_confidence()) Put<float>(buf, c.confidence[i]);
+    if (c.has_support()) Put<uint16_t>(buf, c.support[i]);
+    if (buf->size() > kFlushBytes) {
+      os.write(buf->data(), static_cast<std::streamsize>(buf->size()));
+      buf->clear();
+    }
+  }
+}
+
+void Write(const std::string& path, const PointCloud& c,
+           const std::vector<Eigen::Vector3i>* faces) {
+  CheckCloud(path, c);
+  const size_t n = c.size();
+  if (faces)
+    for (const auto& f : *faces)
+      Require(f.minCoeff() >= 0 && static_cast<size_t>(f.maxCoeff()) < n, path,
+              ": face (", f.transpose(), ") refers to a missing vertex (", n,
+              " vertices)");
+  const size_t nf = faces ? faces->size() : 0;
+  const std::string header = Header(n, c, faces ? &nf : nullptr);
   WriteFileAtomically(path, [&](std::ostream& os) {
-    const std::string header = h.str();
     os.write(header.data(), static_cast<std::streamsize>(header.size()));
     std::string buf;
-    const size_t chunk = 1 << 16;
-    buf.reserve(chunk * 40);
-    for (size_t i = 0; i < n; ++i) {
-      for (int k = 0; k < 3; ++k) Put<float>(&buf, c.xyz[i][k]);
-      if (c.has_normal())
-        for (int k = 0; k < 3; ++k) Put<float>(&buf, c.normal[i][k]);
-      if (c.has_rgb())
-        for (int k = 0; k < 3; ++k) {
-          const float v = c.rgb[i][k];
-          Put<uint8_t>(
-              &buf,
-              static_cast<uint8_t>(std::lround(
-                  std::clamp(std::isfinite(v) ? v : 0.f, 0.f, 1.f) * 255)));
-        }
-      if (c.has_confidence()) Put<float>(&buf, c.confidence[i]);
-      if (c.has_support()) Put<uint16_t>(&buf, c.support[i]);
-      if (buf.size() > chunk * 32) {
-        os.write(buf.data(), static_cast<std::streamsize>(buf.size()));
-        buf.clear();
-      }
-    }
+    buf.reserve(kFlushBytes + 64);
+    PutVertices(c, &buf, os);
     if (faces)
       for (const auto& f : *faces) {
         Put<uint8_t>(&buf, 3);
         for (int k = 0; k < 3; ++k) Put<int32_t>(&buf, f[k]);
-        if (buf.size() > chunk * 32) {
+        if (buf.size() > kFlushBytes) {
           os.write(buf.data(), static_cast<std::streamsize>(buf.size()));
           buf.clear();
         }
@@ -456,6 +468,40 @@ void WritePly(const std::string& path, const PointCloud& cloud) {
 
 void WritePly(const std::string& path, const Mesh& mesh) {
   Write(path, mesh.vertices, &mesh.faces);
+}
+
+void WritePlyChunked(const std::string& path, size_t n,
+                     const PointChunkSource& chunk, size_t chunk_points) {
+  Require(chunk_points > 0, path, ": chunk_points must be > 0");
+  auto get = [&](size_t begin) {
+    const size_t end = std::min(n, begin + chunk_points);
+    PointCloud c = chunk(begin, end);
+    CheckCloud(path, c);
+    Require(c.size() == end - begin, path, ": the chunk source gave ", c.size(),
+            " points for [", begin, ", ", end, ")");
+    return c;
+  };
+  PointCloud first = get(0);
+  const std::string header = Header(n, first, nullptr);
+  auto same_layout = [&](const PointCloud& c) {
+    return c.has_normal() == first.has_normal() &&
+           c.has_rgb() == first.has_rgb() &&
+           c.has_confidence() == first.has_confidence() &&
+           c.has_support() == first.has_support();
+  };
+  WriteFileAtomically(path, [&](std::ostream& os) {
+    os.write(header.data(), static_cast<std::streamsize>(header.size()));
+    std::string buf;
+    buf.reserve(kFlushBytes + 64);
+    PutVertices(first, &buf, os);
+    for (size_t begin = first.size(); begin < n; begin += chunk_points) {
+      const PointCloud c = get(begin);
+      Require(same_layout(c), path, ": the chunk at point ", begin,
+              " has other attributes than the first");
+      PutVertices(c, &buf, os);
+    }
+    os.write(buf.data(), static_cast<std::streamsize>(buf.size()));
+  });
 }
 
 PointCloud ReadPlyCloud(const std::string& path) {

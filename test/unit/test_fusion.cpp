@@ -197,6 +197,39 @@ TEST(Fusion, StreamingEqualsBatch) {
   }
 }
 
+// Cloud(begin, end) are the slices of Cloud(); Finish() keeps the cloud,
+// releases maps and pending samples, and refuses more views.
+TEST(Fusion, CloudRangesAndFinish) {
+  Provider prov;
+  prov.n = 6;
+  FusionOptions o;
+  StreamingFusion s(o, prov.Get());
+  for (int v = 0; v < prov.n; ++v) s.AddView(v);
+  EXPECT_GT(s.stats().pending, 0u);
+  const PointCloud whole = s.Cloud();
+  ASSERT_GT(whole.size(), 10000u);  // several ranges of 7001 below
+  s.Finish();
+  EXPECT_EQ(s.stats().pending, 0u);
+  EXPECT_EQ(s.stats().held_map_bytes, 0u);
+  EXPECT_EQ(s.num_points(), whole.size());
+  EXPECT_THROW(s.AddView(prov.n), Error);
+  const size_t n = whole.size();
+  for (size_t begin = 0; begin < n;) {
+    const size_t end = std::min(n, begin + 7001);
+    const PointCloud part = s.Cloud(begin, end);
+    ASSERT_EQ(part.size(), end - begin);
+    for (size_t i = begin; i < end; ++i) {
+      ASSERT_EQ(part.xyz[i - begin], whole.xyz[i]) << i;
+      ASSERT_EQ(part.normal[i - begin], whole.normal[i]) << i;
+      ASSERT_EQ(part.confidence[i - begin], whole.confidence[i]) << i;
+      ASSERT_EQ(part.support[i - begin], whole.support[i]) << i;
+    }
+    begin = end;
+  }
+  EXPECT_EQ(s.Cloud(n, n).size(), 0u);
+  EXPECT_THROW(s.Cloud(0, n + 1), Error);
+}
+
 // Samples of early views that lack support wait as pending samples and are
 // promoted when later views agree; without pending samples the first views
 // contribute less.

@@ -38,6 +38,20 @@ PointCloud MakeCloud(size_t n, bool all) {
   return c;
 }
 
+// Points [begin, end) of c.
+PointCloud MakeCloudRange(const PointCloud& c, size_t begin, size_t end) {
+  PointCloud r;
+  auto slice = [&](const auto& from, auto* to) {
+    if (!from.empty()) to->assign(from.begin() + begin, from.begin() + end);
+  };
+  slice(c.xyz, &r.xyz);
+  slice(c.normal, &r.normal);
+  slice(c.rgb, &r.rgb);
+  slice(c.confidence, &r.confidence);
+  slice(c.support, &r.support);
+  return r;
+}
+
 TEST(Ply, CloudRoundTripAllAttributes) {
   const std::string d = testing::MakeTempDir("ply");
   const PointCloud c = MakeCloud(10, true);
@@ -70,6 +84,58 @@ TEST(Ply, CloudRoundTripAllAttributes) {
   PointCloud bad = MakeCloud(3, true);
   bad.confidence.pop_back();
   EXPECT_THROW(WritePly(d + "/bad.ply", bad), Error);
+  EXPECT_FALSE(fs::exists(d + "/bad.ply"));
+  fs::remove_all(d);
+}
+
+// The chunked writer gives the bytes of WritePly of the whole cloud, for
+// chunk sizes that do and do not divide the size, and for no points.
+TEST(Ply, ChunkedWriteEqualsWholeWrite) {
+  const std::string d = testing::MakeTempDir("ply_chunked");
+  for (bool all : {true, false}) {
+    for (size_t n : {size_t{0}, size_t{1}, size_t{10}, size_t{12}}) {
+      const PointCloud c = MakeCloud(n, all);
+      WritePly(d + "/whole.ply", c);
+      const std::string whole = ReadBytes(d + "/whole.ply");
+      for (size_t chunk : {size_t{1}, size_t{3}, size_t{4}, size_t{100}}) {
+        std::vector<std::pair<size_t, size_t>> asked;
+        WritePlyChunked(
+            d + "/chunked.ply", n,
+            [&](size_t begin, size_t end) {
+              asked.emplace_back(begin, end);
+              return MakeCloudRange(c, begin, end);
+            },
+            chunk);
+        EXPECT_EQ(ReadBytes(d + "/chunked.ply"), whole)
+            << "n " << n << " chunk " << chunk << " all " << all;
+        // In order, each range once, one chunk at a time.
+        size_t next = 0;
+        for (const auto& [b, e] : asked) {
+          EXPECT_EQ(b, next);
+          EXPECT_LE(e - b, chunk);
+          next = e;
+        }
+        EXPECT_EQ(next, n);
+      }
+    }
+  }
+  // A source that changes its attributes or gives a wrong count is refused
+  // and leaves no file.
+  const PointCloud c = MakeCloud(6, true);
+  EXPECT_THROW(WritePlyChunked(
+                   d + "/bad.ply", 6,
+                   [&](size_t b, size_t e) {
+                     PointCloud r = MakeCloudRange(c, b, e);
+                     if (b > 0) r.rgb.clear();
+                     return r;
+                   },
+                   3),
+               Error);
+  EXPECT_THROW(
+      WritePlyChunked(
+          d + "/bad.ply", 6,
+          [&](size_t b, size_t) { return MakeCloudRange(c, b, b); }, 3),
+      Error);
   EXPECT_FALSE(fs::exists(d + "/bad.ply"));
   fs::remove_all(d);
 }

@@ -3,7 +3,8 @@
 // truth: a pixel that converges after iteration 6 stops there, the normal
 // and colour scales are updated at every fifth iteration, the oscillation
 // check happens once, a view that leaves the image after settling is
-// replaced, and the acceptance threshold and texture guard act.
+// replaced, the acceptance threshold and texture guard act, and the
+// settling forecast stops only hopeless pixels.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -278,6 +279,68 @@ TEST(MpgcSchedule, TextureGuardRefusesSkyKeepsTexture) {
   EXPECT_GT(tex_kept, 0.99 * tex);
 }
 
+// forecast_iteration: pixels started far from the plane whose views cannot
+// pass kappa fail after that many updates instead of at settling; the
+// others run exactly as without the rule. Only pixels that would have
+// failed anyway are stopped (up to 1 % of them may have recovered).
+TEST(MpgcSchedule, ForecastStopsHopelessPixelsEarly) {
+  const SyntheticScene& s = Plane();
+  const int ref = 2;
+  const PatchContext ctx = MakeContext(s, ref);
+  MpgcOptions paper;
+  MpgcOptions fc = paper;
+  fc.forecast_iteration = 1;  // default margin 0.1 (with margin 0 here 3
+                              // of 27 stopped pixels would have matched)
+  PatchMatcher off(ctx, paper, LocalViewSelectionOptions());
+  PatchMatcher on(ctx, fc, LocalViewSelectionOptions());
+  int fired = 0, fired_but_matched = 0, same = 0, others = 0;
+  long long updates_off = 0, updates_on = 0;
+  for (int y = 10; y < 140; y += 4) {
+    for (int x = 10; x < 190; x += 4) {
+      // Far off the surface (20 % too far, tilted): many windows have no
+      // view that correlates.
+      const double z = s.depth[ref].at<float>(y, x) * 1.2;
+      const Eigen::Vector3d n = Eigen::Vector3d(0.3, 0.2, -1).normalized();
+      PatchResult ra, rb;
+      MatchTrace ta, tb;
+      const bool a = off.Match(x, y, z, n, &ra, &ta);
+      const bool b = on.Match(x, y, z, n, &rb, &tb);
+      updates_off += ta.Count(Kind::kFullUpdate) + ta.Count(Kind::kDepthUpdate);
+      updates_on += tb.Count(Kind::kFullUpdate) + tb.Count(Kind::kDepthUpdate);
+      EXPECT_EQ(ta.Count(Kind::kForecastFailed), 0);
+      if (tb.Count(Kind::kForecastFailed) > 0) {
+        ++fired;
+        EXPECT_FALSE(b);
+        EXPECT_TRUE(tb.Has(1, Kind::kForecastFailed));
+        EXPECT_EQ(tb.events.back().kind, Kind::kForecastFailed);
+        // Stopped at pass 1: only the first update ran.
+        EXPECT_EQ(tb.Count(Kind::kFullUpdate) + tb.Count(Kind::kDepthUpdate),
+                  1);
+        fired_but_matched += a;
+        continue;
+      }
+      ++others;
+      // Not stopped: the very same run.
+      EXPECT_EQ(a, b);
+      EXPECT_EQ(ta.events.size(), tb.events.size());
+      if (a && b) {
+        EXPECT_EQ(ra.depth, rb.depth);
+        EXPECT_EQ(ra.iterations, rb.iterations);
+      }
+      same += a == b;
+    }
+  }
+  std::printf(
+      "forecast fired at %d pixels (%d would have matched), %d others; "
+      "updates %lld -> %lld\n",
+      fired, fired_but_matched, others, updates_off, updates_on);
+  ASSERT_GT(fired, 0);
+  ASSERT_GT(others, 20);
+  EXPECT_EQ(same, others);
+  EXPECT_LE(fired_but_matched, fired / 100);
+  EXPECT_LT(updates_on, updates_off);
+}
+
 TEST(MpgcSchedule, OptionsChecked) {
   MpgcOptions o;
   o.accept_ncc = 1.5;
@@ -287,6 +350,14 @@ TEST(MpgcSchedule, OptionsChecked) {
   EXPECT_THROW(o.Check(), std::exception);
   o = MpgcOptions();
   o.normal_step_halvings = 9;
+  EXPECT_THROW(o.Check(), std::exception);
+  o = MpgcOptions();
+  o.forecast_iteration = o.settle_iterations;  // must come before settling
+  EXPECT_THROW(o.Check(), std::exception);
+  o.forecast_iteration = -2;
+  EXPECT_THROW(o.Check(), std::exception);
+  o = MpgcOptions();
+  o.forecast_margin = -0.1;
   EXPECT_THROW(o.Check(), std::exception);
   EXPECT_NO_THROW(MpgcOptions().Check());
 }

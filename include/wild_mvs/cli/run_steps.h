@@ -113,7 +113,8 @@ struct FuseResult {
 };
 // Fuses the depth maps found in `out` for the views of `scene` (scene
 // order), streaming them from disk; writes `ply` atomically. `cloud`
-// (optional) receives the cloud.
+// (optional) receives the cloud; without it the cloud is written in chunks
+// straight from the fusion (no copy of it is held).
 FuseResult RunFuseStage(const Scene& scene, ImageCache* images,
                         const ReconstructConfig& config, ThreadPool* pool,
                         const std::string& out, const std::string& ply,

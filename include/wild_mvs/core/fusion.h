@@ -57,6 +57,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "wild_mvs/core/block_vector.h"
 #include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/point_cloud.h"
@@ -153,12 +154,19 @@ class StreamingFusion {
   // unchanged (all loading and checks happen before any update).
   void AddView(int view);
   bool HasView(int view) const;
+  // No more views: releases the map cache and the pending samples (they can
+  // no longer gain support), keeping only the cloud. AddView afterwards
+  // throws. Call before taking or writing the cloud at the end of a run.
+  void Finish();
 
   // The current cloud: xyz, unit normal, confidence (mean of the samples),
   // support; rgb (sRGB for display, converted from the linear mean) only
   // when an image provider was given. Point order = creation order
   // (deterministic).
   PointCloud Cloud() const;
+  // Points [begin, end) of Cloud() (end <= num_points()): the cloud can be
+  // written in chunks without a full copy (WritePlyChunked).
+  PointCloud Cloud(size_t begin, size_t end) const;
   size_t num_points() const;
   size_t peak_bytes() const { return stats_.peak_bytes; }
   const FusionStats& stats() const { return stats_; }
@@ -206,8 +214,11 @@ class StreamingFusion {
   std::list<std::pair<int, std::vector<Pending>>> pending_;
   size_t pending_count_ = 0;
 
-  // The cloud: accumulated points and the spatial hash.
-  std::vector<Accum> points_;
+  bool finished_ = false;
+
+  // The cloud: accumulated points (in blocks: no doubling, no copy when it
+  // grows) and the spatial hash.
+  BlockVector<Accum> points_;
   std::unordered_map<uint64_t, uint32_t> hash_;
 
   FusionStats stats_;

@@ -14,6 +14,8 @@
 // line / byte offset.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <string>
 
 #include "wild_mvs/core/point_cloud.h"
@@ -22,6 +24,15 @@ namespace wild_mvs {
 
 void WritePly(const std::string& path, const PointCloud& cloud);
 void WritePly(const std::string& path, const Mesh& mesh);
+
+// Points [begin, end) of a cloud, with the same attributes for every range.
+using PointChunkSource = std::function<PointCloud(size_t begin, size_t end)>;
+// Writes a cloud of n points that `chunk` hands out chunk_points at a time
+// (in order; a cloud of 0 points asks for [0, 0) for its attributes): the
+// same bytes as WritePly of the whole cloud, holding one chunk at a time.
+void WritePlyChunked(const std::string& path, size_t n,
+                     const PointChunkSource& chunk,
+                     size_t chunk_points = 65536);
 
 // Vertices only (faces, if any, are read and checked but dropped).
 PointCloud ReadPlyCloud(const std::string& path);
