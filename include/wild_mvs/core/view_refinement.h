@@ -1,0 +1,67 @@
+// Copyright wild_mvs authors. Re-seeding and refining a view's depth map
+// after the geometric-consistency filter (beyond the paper; docs/ALGORITHM.md
+// section 5.4), inside the region-growing framework.
+//
+// The first pass (ReconstructView) leaves holes: pixels growth never
+// reached, and pixels whose depth the consistency filter removed. The
+// second pass grows R's map again, starting from the filtered map itself:
+//  (a) every consistent sample of R that borders an empty pixel is a held
+//      seed (Seed::held): its empty 4-neighbours are queued with its plane,
+//      as if it had just been grown;
+//  (b) the neighbours' consistent samples are reprojected into R (nearest
+//      depth per pixel, their normals rotated into R's frame); one per
+//      `neighbor_seed_stride` x `neighbor_seed_stride` block of R's empty
+//      pixels is a seed, matched from the reprojected plane.
+// Every candidate still goes through MPGC and its acceptance rule, and the
+// result is filtered again by the pipeline (like OpenMVS's geometric
+// iterations fill holes from the neighbours' estimates, but without a
+// geometric term in the cost).
+#pragma once
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "wild_mvs/core/depth_map.h"
+#include "wild_mvs/core/option_registry.h"
+#include "wild_mvs/core/region_growing.h"
+
+namespace wild_mvs {
+
+struct RefinementOptions {
+  // (beyond the paper) Run the second growing pass after the consistency
+  // filter, then the filter again (`wild_mvs reconstruct`; needs
+  // mvs.consistency.enabled, ignored without it). Off in --preset paper.
+  bool enabled = true;
+  // (a) Grow from R's own consistent samples into the empty pixels.
+  bool grow_from_consistent = true;
+  // (b) Seeds from the neighbours' consistent samples reprojected into R's
+  // empty pixels: one per block of this many pixels square; 0 = none.
+  int neighbor_seed_stride = 4;
+  // The filter after the second pass: a sample it added (or changed) must
+  // be confirmed by this many neighbours' maps (the others by
+  // consistency.min_consistent).
+  int min_consistent_new = 2;
+  void Check() const;
+};
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs.refine".
+void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
+                     RefinementOptions* options);
+
+struct RefinementSeedStats {
+  int held = 0;      // (a) consistent samples that border an empty pixel
+  int neighbor = 0;  // (b) seeds from the neighbours' reprojected samples
+};
+
+// The seeds of R's second pass: (a) and (b) above, in a fixed order (held
+// seeds row-major, then the neighbour seeds block-row-major). `own`: R's
+// filtered map at R's working resolution; `neighbors`: the neighbours'
+// filtered maps (any resolution; null or empty ones are skipped); mask
+// (CV_8U of own's size, may be empty): 0 = never seed there.
+std::vector<Seed> RefinementSeeds(const DepthMap& own,
+                                  const std::vector<const DepthMap*>& neighbors,
+                                  const cv::Mat& mask,
+                                  const RefinementOptions& options,
+                                  RefinementSeedStats* stats);
+
+}  // namespace wild_mvs
