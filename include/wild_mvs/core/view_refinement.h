@@ -31,8 +31,13 @@ namespace wild_mvs {
 struct RefinementOptions {
   // (beyond the paper) Run the second growing pass after the consistency
   // filter, then the filter again (`wild_mvs reconstruct`; needs
-  // mvs.consistency.enabled, ignored without it). Off in --preset paper.
-  bool enabled = true;
+  // mvs.consistency.enabled, ignored without it). Off by default and in
+  // --preset paper: measured (docs/EVALUATION.md) fountain-P11 +0.8 points
+  // of completeness at the same accuracy for +25 % CPU, but the rendered
+  // `clutter` scene regresses (off by more than 5 %: 1.85 -> 2.07 %;
+  // growth from samples of the background confirmed behind one-view
+  // occluders).
+  bool enabled = false;
   // (a) Grow from R's own consistent samples into the empty pixels.
   bool grow_from_consistent = true;
   // (b) Seeds from the neighbours' consistent samples reprojected into R's
