@@ -54,7 +54,7 @@ int RunFuse(const CommandArgs& argv) {
   // Maps left in OUT/raw by `reconstruct --shard` runs: the consistency
   // filter first (it needs every neighbour's raw map).
   const FilterStageResult f =
-      FilterPendingViews(scene, config.mvs.consistency, out, &pool, std::cerr);
+      FilterPendingViews(scene, images, config.mvs, out, &pool, std::cerr);
   if (f.filtered > 0) {
     std::cout << "filtered " << f.filtered << " depth maps (kept " << f.kept
               << " of " << f.samples << " samples)\n";

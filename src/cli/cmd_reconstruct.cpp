@@ -335,7 +335,7 @@ void FuseAndMeshStages(const Scene& scene, ImageCache* images,
   if (config.run.HasStage("fuse")) {
     // Maps that --shard runs left in OUT/raw are filtered first.
     const FilterStageResult pending =
-        FilterPendingViews(scene, config.mvs.consistency, out, pool, log);
+        FilterPendingViews(scene, *images, config.mvs, out, pool, log);
     if (!force && r->depth.computed == 0 && pending.filtered == 0 &&
         !earlier.fusion_options_changed && fs::exists(fused)) {
       log << "fuse: " << fused

@@ -96,8 +96,14 @@ cv::Mat CountConsistentViews(const DepthMap& ref,
 void FilterByConsistency(DepthMap* ref,
                          const std::vector<const DepthMap*>& neighbors,
                          const GeometricConsistencyOptions& options,
-                         ConsistencyStats* stats) {
+                         ConsistencyStats* stats, const cv::Mat& earlier,
+                         int min_consistent_new) {
   Require(ref != nullptr, "FilterByConsistency: null map");
+  Require(earlier.empty() ||
+              (earlier.type() == CV_32F && earlier.size() == ref->depth.size()),
+          "FilterByConsistency: the earlier map must be CV_32F of the map's "
+          "size");
+  const int need_new = std::max(options.min_consistent, min_consistent_new);
   ConsistencyStats st;
   st.samples = ref->empty() ? 0 : ref->CountValid();
   st.kept = st.samples;
@@ -111,9 +117,11 @@ void FilterByConsistency(DepthMap* ref,
       float* d = ref->depth.ptr<float>(y);
       cv::Vec3f* n = ref->normal.ptr<cv::Vec3f>(y);
       float* f = ref->confidence.ptr<float>(y);
+      const float* e = earlier.empty() ? nullptr : earlier.ptr<float>(y);
       for (int x = 0; x < ref->width(); ++x) {
         if (!(d[x] > 0)) continue;
-        if (c[x] >= options.min_consistent) {
+        const bool is_new = e && e[x] != d[x];
+        if (c[x] >= (is_new ? need_new : options.min_consistent)) {
           ++st.kept;
           continue;
         }

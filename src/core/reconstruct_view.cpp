@@ -21,6 +21,7 @@ void MvsOptions::Check() const {
   growing.Check();
   sweep.Check();
   consistency.Check();
+  refine.Check();
   Require(max_image_size >= 0, "mvs.max_image_size = ", max_image_size,
           " must be >= 0 (0 = no limit)");
   Require(mpgc.min_active_views <= local.num_active,
@@ -39,6 +40,7 @@ MvsOptions PaperMvsOptions() {
   o.growing.hypotheses = 0;
   o.sweep.below_seeds = 0;
   o.consistency.enabled = false;
+  o.refine.enabled = false;
   return o;
 }
 
@@ -77,13 +79,14 @@ OwnedImage MakeMatchImage(std::shared_ptr<const cv::Mat> img, bool color) {
   return o;
 }
 
-}  // namespace
-
-DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
-                         const MvsOptions& options, ThreadPool* pool,
-                         ViewReport* report, const cv::Mat& mask,
-                         const std::vector<std::vector<int>>* points_per_view,
-                         const std::atomic<bool>* cancel) {
+// ReconstructView (start null) and RefineView (start: the first pass's
+// filtered map, neighbors: the neighbours' filtered maps).
+DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
+                 const MvsOptions& options, ThreadPool* pool,
+                 ViewReport* report, const cv::Mat& mask,
+                 const std::vector<std::vector<int>>* points_per_view,
+                 const std::atomic<bool>* cancel, const DepthMap* start,
+                 const std::vector<const DepthMap*>* neighbors) {
   const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = ThreadCpuSeconds();
   double body_cpu = 0;
@@ -137,6 +140,19 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
   dm.depth = cv::Mat::zeros(cam.height, cam.width, CV_32F);
   dm.normal = cv::Mat::zeros(cam.height, cam.width, CV_32FC3);
   dm.confidence = cv::Mat::zeros(cam.height, cam.width, CV_32F);
+  if (start) {
+    Require(start->width() == cam.width && start->height() == cam.height &&
+                start->normal.size() == start->depth.size() &&
+                start->confidence.size() == start->depth.size(),
+            "RefineView: the map of view '", scene.views[ref].name, "' is ",
+            start->width(), "x", start->height(),
+            " but its working resolution is ", cam.width, "x", cam.height,
+            " (computed with other options?)");
+    start->depth.copyTo(dm.depth);
+    start->normal.copyTo(dm.normal);
+    start->confidence.copyTo(dm.confidence);
+    rep.start_samples = dm.CountValid();
+  }
 
   if (sel.neighbors.empty()) {
     rep.fallbacks.push_back(
@@ -184,18 +200,24 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
       if (x < 0 || y < 0 || x >= cam.width || y >= cam.height) return;
       seeds.push_back(Seed{x, y, cam.Depth(X)});
     };
-    for (int p : ppv[ref]) add_point(p);
-    if (options.growing.seeds_from_neighbors)
-      for (int v : sel.neighbors)
-        for (int p : ppv[v]) add_point(p);
+    if (start) {
+      // The second pass: seeds from the filtered maps instead.
+      seeds = RefinementSeeds(*start, *neighbors, wmask, options.refine,
+                              &rep.refine_seeds);
+    } else {
+      for (int p : ppv[ref]) add_point(p);
+      if (options.growing.seeds_from_neighbors)
+        for (int v : sel.neighbors)
+          for (int p : ppv[v]) add_point(p);
+    }
 
     GrowStats stats;
     if (!seeds.empty())
       GrowRegions(ctx, options.mpgc, options.local, options.growing, seeds,
                   wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats,
                   cancel);
-    if (stats.seeds_accepted == 0 ||
-        stats.seeds_accepted < options.sweep.below_seeds) {
+    if (!start && (stats.seeds_accepted == 0 ||
+                   stats.seeds_accepted < options.sweep.below_seeds)) {
       // No (or too few) sparse features produced a match: seed the pixels
       // still empty from a plane sweep.
       double lo = dmin, hi = dmax;
@@ -244,6 +266,28 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
   return dm;
 }
 
+}  // namespace
+
+DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
+                         const MvsOptions& options, ThreadPool* pool,
+                         ViewReport* report, const cv::Mat& mask,
+                         const std::vector<std::vector<int>>* points_per_view,
+                         const std::atomic<bool>* cancel) {
+  return RunView(scene, ref, images, options, pool, report, mask,
+                 points_per_view, cancel, nullptr, nullptr);
+}
+
+DepthMap RefineView(const Scene& scene, int ref, ImageCache& images,
+                    const MvsOptions& options, const DepthMap& start,
+                    const std::vector<const DepthMap*>& neighbors,
+                    ThreadPool* pool, ViewReport* report, const cv::Mat& mask,
+                    const std::vector<std::vector<int>>* points_per_view,
+                    const std::atomic<bool>* cancel) {
+  Require(!start.empty(), "RefineView: empty map of view ", ref);
+  return RunView(scene, ref, images, options, pool, report, mask,
+                 points_per_view, cancel, &start, &neighbors);
+}
+
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      MvsOptions* o) {
   auto key = [&prefix](const char* name) {
@@ -263,6 +307,7 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   RegisterOptions(registry, key("growing"), &o->growing);
   RegisterOptions(registry, key("sweep"), &o->sweep);
   RegisterOptions(registry, key("consistency"), &o->consistency);
+  RegisterOptions(registry, key("refine"), &o->refine);
 }
 
 }  // namespace wild_mvs

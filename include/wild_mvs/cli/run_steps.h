@@ -13,6 +13,7 @@
 #include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/core/point_cloud.h"
+#include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/core/stats.h"
 #include "wild_mvs/core/thread_pool.h"
@@ -70,19 +71,50 @@ struct FilterStageResult {
 // layout of depth_map_io.h, with log/S.json), writes the filtered map and
 // its log (with a "consistency" member) to `out`. Views run in parallel on
 // `pool` (may be null); files are written in order, atomically.
-FilterStageResult FilterDepthMaps(const Scene& scene,
-                                  const std::vector<int>& views,
-                                  const GeometricConsistencyOptions& options,
-                                  const std::string& raw,
-                                  const std::string& out, ThreadPool* pool,
-                                  std::ostream& log);
+// `member`: the log's key for the filter's counts. `earlier` (a folder,
+// "" = none): each view's earlier map there; samples that differ from it
+// need min_consistent_new confirmations (FilterByConsistency).
+FilterStageResult FilterDepthMaps(
+    const Scene& scene, const std::vector<int>& views,
+    const GeometricConsistencyOptions& options, const std::string& raw,
+    const std::string& out, ThreadPool* pool, std::ostream& log,
+    const std::string& member = "consistency", const std::string& earlier = "",
+    int min_consistent_new = 0);
+
+struct RefineStageResult {
+  int refined = 0;
+  long long samples_before = 0, samples = 0;
+  std::vector<std::string> failures;
+};
+// The second growing pass (RefineView, core/view_refinement.h) of `views`,
+// in order: reads each view's filtered map and its neighbours' from `in`,
+// writes the grown map and its log (with a "refinement" member) to `out`.
+RefineStageResult RefineDepthMaps(
+    const Scene& scene, const std::vector<int>& views, ImageCache& images,
+    const MvsOptions& mvs, const std::string& in, const std::string& out,
+    ThreadPool* pool, std::ostream& log,
+    const std::vector<std::vector<int>>* points_per_view = nullptr);
+
+// What follows the first pass for `views` (their maps in OUT/raw): the
+// consistency filter into OUT; with mvs.refine.enabled, the filter into
+// OUT/filtered1, the second pass into OUT/refined (from the OUT/filtered1
+// maps of the view and its neighbours) and the filter of those into OUT.
+// Each step skips the views whose output of that step is complete
+// (resumable; every step of every view runs before the next step, so the
+// result does not depend on how the first pass was split into shards).
+// The counts returned are those of the last filter (failures of every step).
+FilterStageResult FinishDepthMaps(
+    const Scene& scene, const std::vector<int>& views, ImageCache& images,
+    const MvsOptions& mvs, ThreadPool* pool, const std::string& out,
+    std::ostream& log,
+    const std::vector<std::vector<int>>* points_per_view = nullptr);
 
 // The views of `scene` with a complete raw map in OUT/raw but no complete
-// final map in OUT (left by --shard runs), filtered with FilterDepthMaps
-// from OUT/raw into OUT; nothing when the filter is disabled. Throws Error
-// listing the views that failed.
-FilterStageResult FilterPendingViews(const Scene& scene,
-                                     const GeometricConsistencyOptions& options,
+// final map in OUT (left by --shard runs), finished with FinishDepthMaps
+// (filter, and the second pass when enabled) into OUT; nothing when the
+// filter is disabled. Throws Error listing the views that failed.
+FilterStageResult FilterPendingViews(const Scene& scene, ImageCache& images,
+                                     const MvsOptions& mvs,
                                      const std::string& out, ThreadPool* pool,
                                      std::ostream& log);
 

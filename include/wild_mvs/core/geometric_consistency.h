@@ -50,9 +50,15 @@ cv::Mat CountConsistentViews(const DepthMap& ref,
 // fewer than options.min_consistent of `neighbors` confirm. No-op when
 // disabled or when no neighbour map is given (nothing to check against:
 // stats->kept = samples).
+// earlier (CV_32F of ref's size, may be empty): an earlier map of the same
+// view (the second pass's start, view_refinement.h); the samples of *ref
+// that differ from it (new or changed) need max(min_consistent,
+// min_consistent_new) confirmations instead.
 void FilterByConsistency(DepthMap* ref,
                          const std::vector<const DepthMap*>& neighbors,
                          const GeometricConsistencyOptions& options,
-                         ConsistencyStats* stats);
+                         ConsistencyStats* stats,
+                         const cv::Mat& earlier = cv::Mat(),
+                         int min_consistent_new = 0);
 
 }  // namespace wild_mvs

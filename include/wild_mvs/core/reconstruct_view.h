@@ -20,6 +20,7 @@
 #include "wild_mvs/core/rescaling.h"
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/core/thread_pool.h"
+#include "wild_mvs/core/view_refinement.h"
 
 namespace wild_mvs {
 
@@ -33,6 +34,9 @@ struct MvsOptions {
   // The filter of the finished maps against their neighbours' (run by the
   // pipeline after every view's map exists; not by ReconstructView).
   GeometricConsistencyOptions consistency;
+  // The second growing pass after the filter (view_refinement.h; run by the
+  // pipeline, RefineView), then the filter again.
+  RefinementOptions refine;
   bool use_color = true;   // false = match grey images (ablation)
   int max_image_size = 0;  // longest side of R's working image; 0 = any
   void Check() const;
@@ -58,6 +62,9 @@ struct ViewReport {
   int samples = 0;                     // valid depth samples in the result
   long long pixel_visits = 0;          // MPGC runs
   std::vector<std::string> fallbacks;  // "fallback: ..." notes
+  // RefineView only: samples of the map it started from and its seeds.
+  int start_samples = 0;
+  RefinementSeedStats refine_seeds;
   double seconds = 0, cpu_seconds = 0;
   // As JSON: ViewReportJson (wild_mvs/io/report_json.h).
 };
@@ -74,6 +81,20 @@ struct ViewReport {
 // grows with the collection); null = computed here.
 DepthMap ReconstructView(
     const Scene& scene, int ref, ImageCache& images, const MvsOptions& options,
+    ThreadPool* pool, ViewReport* report, const cv::Mat& mask = cv::Mat(),
+    const std::vector<std::vector<int>>* points_per_view = nullptr,
+    const std::atomic<bool>* cancel = nullptr);
+
+// The second pass of view `ref` (view_refinement.h): the same view
+// selection and rescaling as ReconstructView, then region growing into
+// `start` (ref's map after the consistency filter, at the working
+// resolution ReconstructView gives) from RefinementSeeds(start, neighbors)
+// instead of the sparse features; no depth-sweep fallback. Samples of
+// `start` are kept unless a candidate beats them by the revisit margin.
+// Deterministic for any number of threads, like ReconstructView.
+DepthMap RefineView(
+    const Scene& scene, int ref, ImageCache& images, const MvsOptions& options,
+    const DepthMap& start, const std::vector<const DepthMap*>& neighbors,
     ThreadPool* pool, ViewReport* report, const cv::Mat& mask = cv::Mat(),
     const std::vector<std::vector<int>>* points_per_view = nullptr,
     const std::atomic<bool>* cancel = nullptr);
