@@ -179,12 +179,8 @@ TEST_F(Faults, RestartPoseJumpLoadAndSigtermSave) {
     const std::string session0 =
         reset_out.substr(0, reset_out.size() - 4) + "_session0.ply";
     EXPECT_TRUE(WaitFor([&] { return fs::exists(session0); }, 10)) << session0;
-    std::ifstream f(session0);
-    std::string line;
-    long n = -1;
-    while (std::getline(f, line) && line != "end_header")
-      if (line.rfind("element vertex ", 0) == 0) n = std::stol(line.substr(15));
-    EXPECT_GT(n, 100) << session0;  // >= 3 views fused (min_support 3)
+    EXPECT_GT(PlyVertexCount(session0), 100)
+        << session0;  // >= 3 views fused (min_support 3)
     EXPECT_GE(diag.Get("fusion_reset: ", "resets"), 1)
         << diag.Dump("fusion_reset: ");
     EXPECT_LT(diag.Get("fusion_reset: ", "points"),
@@ -344,15 +340,8 @@ TEST_F(Faults, RestartPoseJumpLoadAndSigtermSave) {
   ASSERT_EQ(kill(fusion_pid, SIGTERM), 0);
   ASSERT_TRUE(WaitFor([&] { return kill(fusion_pid, 0) != 0; }, 60))
       << "fusion node did not exit on SIGTERM";
-  std::ifstream ply(out, std::ios::binary);
-  std::string line;
-  ASSERT_TRUE(std::getline(ply, line));
-  EXPECT_EQ(line, "ply");
-  long vertices = -1;
-  while (std::getline(ply, line) && line != "end_header")
-    if (line.rfind("element vertex ", 0) == 0)
-      vertices = std::stol(line.substr(15));
-  EXPECT_GT(vertices, 1000);
+  const long vertices = PlyVertexCount(out);
+  EXPECT_GT(vertices, 1000) << "no valid PLY saved at " << out;
   EXPECT_NEAR(vertices, points, points * 0.05 + 10);
   for (const auto& e : fs::directory_iterator(fs::path(out).parent_path()))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos)

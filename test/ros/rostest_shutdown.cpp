@@ -10,7 +10,6 @@
 
 #include <atomic>
 #include <filesystem>
-#include <fstream>
 
 #include "ros_test_scene.h"
 #include "rostest_util.h"
@@ -102,15 +101,8 @@ TEST(Shutdown, WithinRoslaunchEscalation) {
   const double fusion_seconds = SecondsToExit(fusion_pid, 60);
   EXPECT_LT(fusion_seconds, kEscalationSeconds)
       << "the fusion node did not end within roslaunch's SIGINT timeout";
-  std::ifstream ply(out, std::ios::binary);
-  std::string line;
-  ASSERT_TRUE(std::getline(ply, line)) << "nothing saved at " << out;
-  EXPECT_EQ(line, "ply");
-  long vertices = -1;
-  while (std::getline(ply, line) && line != "end_header")
-    if (line.rfind("element vertex ", 0) == 0)
-      vertices = std::stol(line.substr(15));
-  EXPECT_GT(vertices, 1000);
+  const long vertices = PlyVertexCount(out);
+  EXPECT_GT(vertices, 1000) << "no valid PLY saved at " << out;
   EXPECT_GE(vertices, points);
   std::printf(
       "[shutdown] depth node: %ld depth maps done, SIGINT during the next "

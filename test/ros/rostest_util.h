@@ -118,6 +118,19 @@ inline double PeakRssMb(int pid) {
   return -1;
 }
 
+// The vertex count of the PLY file at `path` (its header), or -1 when the
+// file is missing or does not start with "ply".
+inline long PlyVertexCount(const std::string& path) {
+  std::ifstream ply(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(ply, line) || line != "ply") return -1;
+  long vertices = -1;
+  while (std::getline(ply, line) && line != "end_header")
+    if (line.rfind("element vertex ", 0) == 0)
+      vertices = std::stol(line.substr(15));
+  return vertices;
+}
+
 // Runs `rosbag play` on `bag` in a background thread.
 inline std::thread PlayBag(const std::string& bag, double rate,
                            const std::string& extra = "") {
