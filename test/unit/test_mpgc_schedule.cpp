@@ -76,7 +76,9 @@ TEST(MpgcSchedule, PixelOnItsPlaneConvergesAtIterationSix) {
 // With an unreachable eps (and no drops) the patch cannot converge before
 // it reaches its floating-point fixpoint: the normal and colour scales are
 // fitted at iterations 1 (the new active set) and 5, the depth alone at the
-// others, and the match fails after max_iterations (9 here).
+// others, and the match fails after max_iterations (7 here: the fixpoint
+// of the float NCC sums comes at iteration 8 with clang's AVX2 kernels,
+// later with GCC's).
 TEST(MpgcSchedule, FullUpdateEveryFifthIterationAndFailureAfterMax) {
   const SyntheticScene& s = Plane();
   const int ref = 2, x = 90, y = 70;
@@ -85,7 +87,7 @@ TEST(MpgcSchedule, FullUpdateEveryFifthIterationAndFailureAfterMax) {
   mo.convergence_eps = 1e-300;
   mo.drop_ncc = -1;
   mo.oscillation_iteration = 0;  // never
-  mo.max_iterations = 9;
+  mo.max_iterations = 7;
   PatchMatcher m(ctx, mo, LocalViewSelectionOptions());
   MatchTrace tr;
   // Started 5 % off: from 3 % the float NCC sums of the SIMD kernels
@@ -104,8 +106,8 @@ TEST(MpgcSchedule, FullUpdateEveryFifthIterationAndFailureAfterMax) {
     if (e.kind == Kind::kDepthUpdate) ++depth_only;
   }
   EXPECT_EQ(full, 2);
-  EXPECT_EQ(depth_only, 7);
-  EXPECT_TRUE(tr.Has(9, Kind::kFailed));
+  EXPECT_EQ(depth_only, 5);
+  EXPECT_TRUE(tr.Has(7, Kind::kFailed));
   EXPECT_EQ(tr.events.back().kind, Kind::kFailed);
   if (::testing::Test::HasFailure()) PrintTrace(tr);
 }
