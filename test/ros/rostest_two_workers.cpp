@@ -75,11 +75,8 @@ TEST(TwoWorkers, SameCloudAsOneWorker) {
                c1.getNumPublishers() > 0 && c2.getNumPublishers() > 0;
       },
       60));
-  // Every depth node (one + two workers) is up and subscribed to the images
-  // before the bag starts (a late nodelet missed the first frames under
-  // load): each publishes diagnostics once constructed (after subscribing),
-  // and both processes (depth_node, the manager) connect to a silent
-  // publisher of the image topic.
+  // Every depth node (one + two workers) is up and subscribed before the bag
+  // starts: each publishes diagnostics once constructed (after subscribing).
   ASSERT_TRUE(WaitFor(
       [&] {
         return diag.Get("one/depth_node", "input queue size") > 0 &&
@@ -87,14 +84,9 @@ TEST(TwoWorkers, SameCloudAsOneWorker) {
                diag.Get("two/depth_worker_1", "input queue size") > 0;
       },
       60));
-  {
-    ros::Publisher probe =
-        nh.advertise<sensor_msgs::Image>("/camera/image_raw", 1);
-    ASSERT_TRUE(WaitFor([&] { return probe.getNumSubscribers() >= 2; }, 60))
-        << probe.getNumSubscribers() << " image subscribers";
-  }
-  ros::WallDuration(1.0).sleep();
-  std::thread player = PlayBag(bag, 1.0);
+  // Both processes (one/depth_node and the manager of the two workers)
+  // connected on every topic before the first message.
+  std::thread player = PlayBagConnected(bag, 1.0, 2);
   player.join();
   ASSERT_TRUE(WaitFor(
       [&] {

@@ -2,16 +2,22 @@
 #pragma once
 
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
 #include <ros/network.h>
 #include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <std_srvs/SetBool.h>
+#include <unistd.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 
 #include <cstdlib>
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 
@@ -89,23 +95,57 @@ inline PointCloud CloudFromMsg(const sensor_msgs::PointCloud2& msg) {
   return c;
 }
 
-// Process id of a node (XML-RPC getPid), or -1.
-inline int NodePid(const std::string& node) {
-  XmlRpc::XmlRpcValue args, result, payload;
+// Calls the slave API method `method` of `node` (looked up at the master)
+// with this node as caller; false when the node or the call fails. `result`
+// is the call's [code, message, value].
+inline bool CallNodeApi(const std::string& node, const std::string& method,
+                        XmlRpc::XmlRpcValue* result) {
+  XmlRpc::XmlRpcValue args, lookup, payload;
   args[0] = ros::this_node::getName();
   args[1] = node;
-  if (!ros::master::execute("lookupNode", args, result, payload, false))
-    return -1;
+  if (!ros::master::execute("lookupNode", args, lookup, payload, false))
+    return false;
   std::string uri = payload;
   std::string host;
   uint32_t port = 0;
-  if (!ros::network::splitURI(uri, host, port)) return -1;
+  if (!ros::network::splitURI(uri, host, port)) return false;
   XmlRpc::XmlRpcClient client(host.c_str(), port, "/");
-  XmlRpc::XmlRpcValue a, r;
+  XmlRpc::XmlRpcValue a;
   a[0] = ros::this_node::getName();
-  if (!client.execute("getPid", a, r)) return -1;
-  if (r.getType() != XmlRpc::XmlRpcValue::TypeArray || r.size() < 3) return -1;
+  return client.execute(method.c_str(), a, *result) &&
+         result->getType() == XmlRpc::XmlRpcValue::TypeArray &&
+         result->size() >= 3;
+}
+
+// Process id of a node (XML-RPC getPid), or -1.
+inline int NodePid(const std::string& node) {
+  XmlRpc::XmlRpcValue r;
+  if (!CallNodeApi(node, "getPid", &r)) return -1;
   return static_cast<int>(r[2]);
+}
+
+// Connected subscribers per topic that `node` publishes (its getBusInfo:
+// [id, destination, direction "o"/"i", transport, topic, connected, ...]).
+inline std::map<std::string, int> PublishedConnections(
+    const std::string& node) {
+  std::map<std::string, int> out;
+  XmlRpc::XmlRpcValue r;
+  if (!CallNodeApi(node, "getBusInfo", &r) ||
+      r[2].getType() != XmlRpc::XmlRpcValue::TypeArray)
+    return out;
+  for (int i = 0; i < r[2].size(); ++i) {
+    XmlRpc::XmlRpcValue& c = r[2][i];
+    if (c.getType() != XmlRpc::XmlRpcValue::TypeArray || c.size() < 5 ||
+        c[2].getType() != XmlRpc::XmlRpcValue::TypeString ||
+        c[4].getType() != XmlRpc::XmlRpcValue::TypeString)
+      continue;
+    if (static_cast<std::string>(c[2]) != "o") continue;
+    if (c.size() >= 6 && c[5].getType() == XmlRpc::XmlRpcValue::TypeBoolean &&
+        !static_cast<bool>(c[5]))
+      continue;
+    ++out[static_cast<std::string>(c[4])];
+  }
+  return out;
 }
 
 // Peak resident set size (VmHWM) of a process in MB, or -1.
@@ -143,6 +183,64 @@ inline std::thread PlayBag(const std::string& bag, double rate,
                           " >/dev/null 2>&1";
   return std::thread([cmd] {
     if (std::system(cmd.c_str()) != 0) ROS_ERROR("failed: %s", cmd.c_str());
+  });
+}
+
+// Runs `rosbag play` on `bag` in a background thread, started paused and
+// unpaused only once every topic of the bag has at least `min_subscribers`
+// connected subscribers at the player (its outgoing connections), so that
+// no subscriber misses the first messages however slowly its connections
+// come up on a loaded machine (a fixed -d pause was not enough: a nodelet
+// manager connected after the first image). Fails the test (ADD_FAILURE)
+// when the connections do not come within `timeout` seconds; plays anyway.
+inline std::thread PlayBagConnected(const std::string& bag, double rate,
+                                    int min_subscribers,
+                                    const std::string& extra = "",
+                                    double timeout = 60.0) {
+  const std::string name =
+      "wild_mvs_player_" + std::to_string(getpid()) + "_" +
+      std::to_string(ros::WallTime::now().toNSec() % 1000000000ull);
+  std::set<std::string> topics;
+  {
+    rosbag::Bag b(bag, rosbag::bagmode::Read);
+    rosbag::View view(b);
+    for (const rosbag::ConnectionInfo* c : view.getConnections())
+      topics.insert(c->topic);
+  }
+  const std::string cmd = "rosbag play --quiet --pause -r " +
+                          std::to_string(rate) + " '" + bag + "' " + extra +
+                          " __name:=" + name + " >/dev/null 2>&1";
+  return std::thread([cmd, name, topics, min_subscribers, timeout] {
+    std::thread play([cmd] {
+      if (std::system(cmd.c_str()) != 0) ROS_ERROR("failed: %s", cmd.c_str());
+    });
+    const std::string node = "/" + name;
+    std::map<std::string, int> connected;
+    const bool ready = WaitFor(
+        [&] {
+          connected = PublishedConnections(node);
+          for (const std::string& t : topics)
+            if (connected[t] < min_subscribers) return false;
+          return ros::service::exists(node + "/pause_playback", false);
+        },
+        timeout);
+    if (!ready) {
+      std::string s;
+      for (const std::string& t : topics)
+        s += " " + t + ":" + std::to_string(connected[t]);
+      ADD_FAILURE() << "rosbag play " << node << ": fewer than "
+                    << min_subscribers << " subscribers after " << timeout
+                    << " s:" << s;
+    }
+    std_srvs::SetBool resume;
+    resume.request.data = false;
+    if (!WaitFor(
+            [&] {
+              return ros::service::call(node + "/pause_playback", resume);
+            },
+            10))
+      ADD_FAILURE() << "could not unpause " << node;
+    play.join();
   });
 }
 
