@@ -47,6 +47,12 @@ void MpgcOptions::Check() const {
           "mvs.mpgc.min_facing = ", min_facing, " must be in [0, 1)");
   Require(accept_ncc >= -1 && accept_ncc <= 1,
           "mvs.mpgc.accept_ncc = ", accept_ncc, " must be in [-1, 1]");
+  Require(explain_margin == -1 || (explain_margin >= 0 && explain_margin <= 2),
+          "mvs.mpgc.explain_margin = ", explain_margin,
+          " must be -1 (off) or in [0, 2]");
+  Require(explain_below_ncc >= -1 && explain_below_ncc <= 1.5,
+          "mvs.mpgc.explain_below_ncc = ", explain_below_ncc,
+          " must be in [-1, 1.5]");
   Require(min_texture_levels >= 0 && min_texture_levels <= 64,
           "mvs.mpgc.min_texture_levels = ", min_texture_levels,
           " must be in [0, 64]");
@@ -516,7 +522,19 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   for (int a = 0; a < num_active_; ++a) sum += slots_[active_slot_[a]].ncc;
   const double mean_ncc = sum / num_active_;
   if (mean_ncc < mpgc_.accept_ncc) return false;
+  double pair_ncc = std::numeric_limits<double>::quiet_NaN();
+  if (mpgc_.explain_margin >= 0 && num_active_ >= 2 &&
+      mean_ncc < mpgc_.explain_below_ncc) {
+    // Not even the best view explains R's window as well as the views
+    // explain each other's.
+    double best = -1;
+    for (int a = 0; a < num_active_; ++a)
+      best = std::max(best, slots_[active_slot_[a]].ncc);
+    pair_ncc = MeanPairwiseNcc();
+    if (best < pair_ncc - mpgc_.explain_margin) return false;
+  }
   if (!out) return true;
+  out->pair_ncc = pair_ncc;
   out->depth = h_ * ray.z();
   out->normal = mpgc_.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);
   out->confidence = std::clamp((mean_ncc + 1.0) * 0.5, 0.0, 1.0);
@@ -530,6 +548,41 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
       out->color_scale[a][c] = sl.scale[channels_ == 1 ? 0 : c];
   }
   return true;
+}
+
+double PatchMatcher::MeanPairwiseNcc() const {
+  if (num_active_ < 2) return 1;
+  // Mean-free copies of the active windows (per channel).
+  float c[kMaxActive][mpgc_kernels::kWindowFloats];
+  double ss[kMaxActive];
+  for (int a = 0; a < num_active_; ++a) {
+    const float* v = slots_[active_slot_[a]].val;
+    ss[a] = 0;
+    for (int ch = 0; ch < channels_; ++ch) {
+      double m = 0;
+      for (int i = 0; i < npix_; ++i) m += v[4 * i + ch];
+      m /= npix_;
+      for (int i = 0; i < npix_; ++i) {
+        const float d = static_cast<float>(v[4 * i + ch] - m);
+        c[a][4 * i + ch] = d;
+        ss[a] += static_cast<double>(d) * d;
+      }
+    }
+  }
+  const double floor = kNccMinVariance * npix_ * channels_;
+  double sum = 0;
+  int pairs = 0;
+  for (int a = 0; a < num_active_; ++a)
+    for (int b = a + 1; b < num_active_; ++b) {
+      double sab = 0;
+      for (int ch = 0; ch < channels_; ++ch)
+        for (int i = 0; i < npix_; ++i)
+          sab += static_cast<double>(c[a][4 * i + ch]) * c[b][4 * i + ch];
+      sum += (ss[a] < floor || ss[b] < floor) ? -1
+                                              : sab / std::sqrt(ss[a] * ss[b]);
+      ++pairs;
+    }
+  return sum / pairs;
 }
 
 // The paper's schedule (section 6.2). Iteration k = the k-th update; the
@@ -666,6 +719,19 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "(paper)")
       .Min(-1)
       .Max(1);
+  registry
+      ->Add(key("explain_margin"), &o->explain_margin,
+            "fail a match whose best view's NCC with R is more than this "
+            "below the views' mean NCC with each other (R sees something "
+            "they do not: a one-view occluder); -1 = off (paper)")
+      .Min(-1)
+      .Max(2);
+  registry
+      ->Add(key("explain_below_ncc"), &o->explain_below_ncc,
+            "explain_margin tests only matches whose mean NCC with R is "
+            "below this (> 1 = every match)")
+      .Min(-1)
+      .Max(1.5);
   registry
       ->Add(key("min_texture_levels"), &o->min_texture_levels,
             "do not match reference windows whose spread is below this many "

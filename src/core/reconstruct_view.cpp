@@ -32,6 +32,7 @@ void MvsOptions::Check() const {
 MvsOptions PaperMvsOptions() {
   MvsOptions o;
   o.mpgc.accept_ncc = -1;
+  o.mpgc.explain_margin = -1;
   o.mpgc.min_texture_levels = 0;
   o.mpgc.normal_step_halvings = 0;
   o.mpgc.forecast_iteration = -1;

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "wild_mvs/core/local_view_selection.h"
@@ -36,6 +37,17 @@ struct MpgcOptions {
   // (beyond the paper; MVE's dmrecon: 0.6) Accept a converged match only
   // when the mean NCC over A reaches this; -1 = accept any (paper).
   double accept_ncc = -1;
+  // (beyond the paper) The reference must be explained: a converged match
+  // fails when the best NCC of an active view with R falls more than this
+  // below the active views' mean NCC with each other. There the views agree
+  // about a
+  // surface that R's window does not show (R alone sees a transient
+  // occluder in front of it, the neighbours the background behind it;
+  // docs/EVALUATION.md, "One-view occluders"). -1 = off (paper).
+  double explain_margin = -1;
+  // Only matches whose mean NCC with R is below this are tested (a window
+  // that R's views explain this well is not the wrong surface); > 1 = all.
+  double explain_below_ncc = 1.1;
   // (beyond the paper) A reference window whose intensity spread is below
   // this many 8-bit sRGB levels (standard deviation, mean over channels) is
   // not matched: sky, saturated or blank walls, where NCC is noise. 0 =
@@ -101,6 +113,9 @@ struct PatchResult {
   double depth = 0;                  // z of the pixel centre
   Eigen::Vector3d normal{0, 0, -1};  // camera frame, facing the camera
   double confidence = 0;             // mean NCC over A mapped to [0, 1]
+  // Mean NCC of A's views with each other (computed when explain_margin is
+  // on, else NaN).
+  double pair_ncc = std::numeric_limits<double>::quiet_NaN();
   int iterations = 0;
   int num_active = 0;
   int active[kMaxActive] = {};  // indices into PatchContext::views
@@ -158,6 +173,9 @@ class PatchMatcher {
   bool DepthStep();
   bool FullStep(bool fit_normal, bool fit_scale);
   bool MakeResult(int iterations, PatchResult* out) const;
+  // Mean NCC of the active views' windows with each other (pairs of A; the
+  // channels pooled as in SlotNcc). 1 with fewer than two views.
+  double MeanPairwiseNcc() const;
   void Note(int iteration, MatchTrace::Kind kind, int view) {
     if (trace_) trace_->events.push_back({iteration, kind, view});
   }
