@@ -9,7 +9,8 @@
 #   bench/run_scale.sh [--sizes 100,250,500] [--max-image-size 240]
 #                      [--threads 2] [--work /tmp/wild_mvs_scale]
 #                      [--image-cache-mb 64] [--map-cache-mb 64]
-#                      [--pending-mb 32] [--no-results] [--table-only]
+#                      [--pending-mb 32] [--fusion-mb MAP+PENDING]
+#                      [--no-results] [--table-only] [--rss-trace]
 #                      [-- EXTRA_FLAGS...]
 #
 # Collections are rendered into WORK (never into the repository) once and
@@ -21,7 +22,9 @@
 # to bench/results/scale.tsv with the raw outputs (time -v, summary.json,
 # the log's summary lines) under bench/results/scale/ (--no-results: stdout
 # only). --table-only: no rendering or runs, the table of the runs already in
-# WORK (e.g. one size per invocation, then all sizes). BUILD_DIR (default build/) holds bin/wild_mvs and bin/make_collection.
+# WORK (e.g. one size per invocation, then all sizes). --rss-trace: sample
+# the process's VmRSS every second into WORK/rssN.tsv (seconds, MB, the
+# log's last line: where the peak is), copied with the results. BUILD_DIR (default build/) holds bin/wild_mvs and bin/make_collection.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
@@ -33,8 +36,10 @@ WORK=/tmp/wild_mvs_scale
 IMAGE_CACHE_MB=64
 MAP_CACHE_MB=64
 PENDING_MB=32
+FUSION_MB=""  # default: MAP_CACHE_MB + PENDING_MB
 RESULTS=1
 TABLE_ONLY=0
+RSS_TRACE=0
 EXTRA=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -45,12 +50,18 @@ while [ $# -gt 0 ]; do
     --image-cache-mb) IMAGE_CACHE_MB="$2"; shift 2 ;;
     --map-cache-mb) MAP_CACHE_MB="$2"; shift 2 ;;
     --pending-mb) PENDING_MB="$2"; shift 2 ;;
+    --fusion-mb) FUSION_MB="$2"; shift 2 ;;
     --no-results) RESULTS=0; shift ;;
     --table-only) TABLE_ONLY=1; shift ;;
+    --rss-trace) RSS_TRACE=1; shift ;;
     --) shift; EXTRA=("$@"); break ;;
     *) echo "run_scale.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
+# The fusion's joint budget (maps + pending samples + cloud,
+# fusion.memory_mb): the room the map cache and the pending samples have,
+# which the cloud then shares with them (0 = none, the cloud on top).
+[ -n "$FUSION_MB" ] || FUSION_MB=$(awk -v a="$MAP_CACHE_MB" -v b="$PENDING_MB" 'BEGIN {print a + b}')
 for tool in wild_mvs make_collection; do
   [ -x "$BIN/$tool" ] || { echo "run_scale.sh: $BIN/$tool missing (build first)" >&2; exit 1; }
 done
@@ -83,6 +94,26 @@ if [ "$TABLE_ONLY" = 0 ]; then
   for n in "${sizes[@]}"; do [ "$n" -ne "$largest" ] && render "$n"; done
 fi
 
+# rss_trace PID OUT LOG: VmRSS of PID's child (the tool under time -v)
+# every second until it exits.
+rss_trace() {
+  local pid="" t0 i
+  for ((i = 0; i < 50; i++)); do
+    pid=$(pgrep -P "$1" | head -1)
+    [ -z "$pid" ] || break
+    sleep 0.1
+  done
+  [ -n "$pid" ] || return 0
+  t0=$(date +%s)
+  : >"$2"
+  while kill -0 "$pid" 2>/dev/null; do
+    printf '%s\t%s\t%s\n' "$(($(date +%s) - t0))" \
+      "$(awk '/VmRSS/ {print int($2 / 1024)}' "/proc/$pid/status" 2>/dev/null)" \
+      "$(tail -c 300 "$3" 2>/dev/null | tr '\r' '\n' | grep -v '^$' | tail -1 | cut -c1-80)" >>"$2"
+    sleep 1
+  done
+}
+
 TSV="views	cpu_s	cpu_s_per_view	mvs_cpu_s_per_view	wall_s	peak_rss_mb	samples	fused_points	samples_per_view"
 rows=()
 for n in "${sizes[@]}"; do
@@ -90,11 +121,17 @@ for n in "${sizes[@]}"; do
   if [ "$TABLE_ONLY" = 0 ]; then
     rm -rf "$out"
     echo "run_scale: reconstructing $n views at --max-image-size $MAX_IMAGE..." >&2
+    rm -f "$WORK/rss$n.tsv"
     /usr/bin/time -v -o "$WORK/time$n.txt" "$BIN/wild_mvs" reconstruct "$WORK/c$n" "$out" \
       --max-image-size "$MAX_IMAGE" --stages depth,fuse --threads "$THREADS" \
       --image.cache_mb "$IMAGE_CACHE_MB" --fusion.map_cache_mb "$MAP_CACHE_MB" \
-      --fusion.pending_mb "$PENDING_MB" "${EXTRA[@]}" >"$WORK/log$n.txt" 2>&1 \
-      || { tail -20 "$WORK/log$n.txt" >&2; echo "run_scale.sh: run of $n views failed" >&2; exit 1; }
+      --fusion.pending_mb "$PENDING_MB" --fusion.memory_mb "$FUSION_MB" \
+      "${EXTRA[@]}" >"$WORK/log$n.txt" 2>&1 &
+    tpid=$!
+    [ "$RSS_TRACE" = 0 ] || rss_trace "$tpid" "$WORK/rss$n.tsv" "$WORK/log$n.txt" &
+    wait "$tpid" ||
+      { tail -20 "$WORK/log$n.txt" >&2; echo "run_scale.sh: run of $n views failed" >&2; exit 1; }
+    wait
   fi
   [ -f "$WORK/time$n.txt" ] && [ -f "$out/summary.json" ] ||
     { echo "run_scale.sh: no finished run of $n views in $WORK" >&2; exit 1; }
@@ -117,7 +154,7 @@ for n in "${sizes[@]}"; do
 done
 
 {
-  echo "# bench/run_scale.sh $(date -u +%Y-%m-%dT%H:%MZ): --max-image-size $MAX_IMAGE --threads $THREADS --image.cache_mb $IMAGE_CACHE_MB --fusion.map_cache_mb $MAP_CACHE_MB --fusion.pending_mb $PENDING_MB ${EXTRA[*]:-}; $(nproc) cores"
+  echo "# bench/run_scale.sh $(date -u +%Y-%m-%dT%H:%MZ): --max-image-size $MAX_IMAGE --threads $THREADS --image.cache_mb $IMAGE_CACHE_MB --fusion.map_cache_mb $MAP_CACHE_MB --fusion.pending_mb $PENDING_MB --fusion.memory_mb $FUSION_MB ${EXTRA[*]:-}; $(nproc) cores"
   echo "$TSV"
   printf '%s\n' "${rows[@]}"
 } >"$WORK/scale.tsv"
@@ -128,6 +165,7 @@ if [ "$RESULTS" = 1 ]; then
   for n in "${sizes[@]}"; do
     cp "$WORK/time$n.txt" "$ROOT/bench/results/scale/time_$n.txt"
     cp "$WORK/out$n/summary.json" "$ROOT/bench/results/scale/summary_$n.json"
+    [ ! -f "$WORK/rss$n.tsv" ] || cp "$WORK/rss$n.tsv" "$ROOT/bench/results/scale/rss_$n.tsv"
     grep -E '^(dataset|sparse|depth:|fuse|summary)' "$WORK/log$n.txt" \
       >"$ROOT/bench/results/scale/log_$n.txt" || true
   done

@@ -13,6 +13,7 @@
 #include "wild_mvs/cli/args.h"
 #include "wild_mvs/cli/commands.h"
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/stats.h"
 
 namespace {
 
@@ -36,6 +37,9 @@ void PrintUsage(std::ostream& os) {
 
 int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);  // a closed pipe gives a write error
+  // Freed images and depth maps go back to the system instead of leaving
+  // holes in the heap (the peak RSS of long runs, docs/SCALE.md).
+  wild_mvs::UseFixedMmapThreshold();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     PrintUsage(std::cerr);

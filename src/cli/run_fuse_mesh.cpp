@@ -13,6 +13,7 @@
 #include "wild_mvs/cli/scene_setup.h"
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/meshing.h"
+#include "wild_mvs/core/stats.h"
 #include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/ply.h"
@@ -79,9 +80,15 @@ FuseResult RunFuseStage(const Scene& scene, ImageCache* images,
     return std::make_shared<const DepthMap>(
         ReadDepthMapFiles(out, scene.views[v].Stem(), scene));
   };
+  // Fusion reads each view's image once (its samples' colours), so the
+  // images cached for the earlier stages go and the fusion's own are not
+  // cached: its memory depends neither on image.cache_mb nor on how much of
+  // the collection that cache held.
   ImageProvider image;
   if (images) {
-    image = [images](int v) { return *images->Get(v); };
+    images->Clear();
+    ReleaseFreeMemory();
+    image = [images](int v) { return images->Load(v); };
   }
   MaskProvider mask = [&](int v) { return LoadViewMask(scene.views[v]); };
   StreamingFusion fusion(config.fusion, depth, image, mask, pool);

@@ -47,6 +47,8 @@ void FusionOptions::Check() const {
           "fusion.map_cache_mb = ", map_cache_mb, " must be >= 0");
   Require(std::isfinite(pending_mb) && pending_mb >= 0,
           "fusion.pending_mb = ", pending_mb, " must be >= 0");
+  Require(std::isfinite(memory_mb) && memory_mb >= 0,
+          "fusion.memory_mb = ", memory_mb, " must be >= 0");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -108,6 +110,11 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry
       ->Add(key("pending_mb"), &o->pending_mb,
             "budget of not-yet-supported samples in MB, 0 = none")
+      .Min(0);
+  registry
+      ->Add(key("memory_mb"), &o->memory_mb,
+            "joint budget of cached maps + pending samples + cloud in MB "
+            "(maps are evicted for it), 0 = none")
       .Min(0);
 }
 
@@ -223,6 +230,30 @@ size_t StreamingFusion::CloudBytes() const {
   return points_.bytes() +
          hash_.size() * (sizeof(uint64_t) * 2 + sizeof(void*) * 2) +
          hash_.bucket_count() * sizeof(void*);
+}
+
+size_t StreamingFusion::MapCap() const {
+  size_t cap = static_cast<size_t>(options_.map_cache_mb * kMB);
+  if (options_.memory_mb > 0) {
+    const size_t total = static_cast<size_t>(options_.memory_mb * kMB);
+    const size_t others = PendingBytes() + CloudBytes();
+    cap = std::min(cap, total > others ? total - others : 0);
+  }
+  return cap;
+}
+
+void StreamingFusion::EvictMaps() {
+  // Least recently used first; maps in use elsewhere (use_count > 1: the
+  // view being added, the related map being checked) stay.
+  const size_t cap = MapCap();
+  for (auto e = lru_.end(); lru_bytes_ > cap && e != lru_.begin();) {
+    --e;
+    if (e->second.use_count() == 1) {
+      lru_bytes_ -= e->second->bytes();
+      lru_index_.erase(e->first);
+      e = lru_.erase(e);
+    }
+  }
 }
 
 void StreamingFusion::UpdatePeak() {
@@ -366,16 +397,7 @@ std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::GetMap(
   lru_.emplace_front(view, p);
   lru_index_[view] = lru_.begin();
   lru_bytes_ += p->bytes();
-  // Evict least recently used maps that nobody else holds.
-  const size_t cap = static_cast<size_t>(options_.map_cache_mb * kMB);
-  for (auto e = lru_.end(); lru_bytes_ > cap && e != lru_.begin();) {
-    --e;
-    if (e->second.use_count() == 1) {
-      lru_bytes_ -= e->second->bytes();
-      lru_index_.erase(e->first);
-      e = lru_.erase(e);
-    }
-  }
+  EvictMaps();
   UpdatePeak();
   return p;
 }
@@ -698,13 +720,9 @@ void StreamingFusion::AddView(int view) {
   UpdatePeak();  // pending counted before trimming: it was held
   TrimPending();
   v.reset();
-  // Respect the map budget now that no map is in use.
-  const size_t cap = static_cast<size_t>(options_.map_cache_mb * kMB);
-  while (lru_bytes_ > cap && !lru_.empty()) {
-    lru_bytes_ -= lru_.back().second->bytes();
-    lru_index_.erase(lru_.back().first);
-    lru_.pop_back();
-  }
+  // Respect the map budget now that no map is in use (the cloud and the
+  // pending samples may have grown).
+  EvictMaps();
   UpdatePeak();
 }
 

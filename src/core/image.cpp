@@ -144,6 +144,13 @@ std::shared_ptr<const cv::Mat> ImageCache::GetResized(int view, int width,
   return img;
 }
 
+void ImageCache::Clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  lru_.clear();
+  index_.clear();
+  bytes_ = 0;
+}
+
 size_t ImageCache::bytes() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return bytes_;

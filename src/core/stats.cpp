@@ -22,6 +22,12 @@ void ReleaseFreeMemory() {
 #endif
 }
 
+void UseFixedMmapThreshold() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+#endif
+}
+
 double PeakRssMb() {
   rusage u;
   if (getrusage(RUSAGE_SELF, &u) != 0) return 0;

@@ -119,6 +119,7 @@ TEST(FusionOptions, CheckRejectsBadValues) {
   bad([](FusionOptions& b) { b.cell_scale = 0; }, "cell_scale");
   bad([](FusionOptions& b) { b.bbox_min.x() = 5, b.bbox_max.x() = 1; }, "bbox");
   bad([](FusionOptions& b) { b.map_cache_mb = -1; }, "map_cache_mb");
+  bad([](FusionOptions& b) { b.memory_mb = NAN; }, "memory_mb");
   bad([](FusionOptions& b) { b.reprojection_tolerance_px = 0; },
       "reprojection_tolerance_px");
 }
@@ -305,6 +306,73 @@ TEST(Fusion, PeakMemoryFlatWhenViewsAdded) {
   // 24 more views (20 MB of maps) add less than a quarter of their size.
   EXPECT_LT(s32.peak_bytes, s8.peak_bytes + 24 * map_bytes / 4);
   EXPECT_GE(calls32, 32);  // maps really were re-loaded, not kept
+}
+
+// The joint budget memory_mb: the cloud takes the cached maps' room as it
+// grows, so the fusion's account (maps + pending + cloud) stays within the
+// budget plus the maps one AddView holds; only maps are given up (and read
+// again), so the cloud is the same point for point.
+TEST(Fusion, JointBudgetEvictsMapsNotResults) {
+  const size_t map_bytes = 240 * 180 * 20;
+  const size_t mb = 1024 * 1024;
+  auto run = [](int n, double memory_mb, int* calls, FusionStats* stats) {
+    Provider prov;
+    prov.n = n;
+    prov.outliers = 0.05;
+    prov.calls = calls;
+    FusionOptions o;
+    o.map_cache_mb = 64;  // every map fits: only memory_mb evicts
+    o.pending_mb = 2;
+    o.memory_mb = memory_mb;
+    StreamingFusion s(o, prov.Get());
+    for (int v = 0; v < n; ++v) {
+      s.AddView(v);
+      // Between views: within the budget (the cloud alone is below it).
+      if (memory_mb > 0) {
+        EXPECT_LE(s.bytes(), static_cast<size_t>(memory_mb * 1024 * 1024))
+            << "after view " << v;
+      }
+    }
+    *stats = s.stats();
+    return s.Cloud();
+  };
+  int calls_free = 0, calls_budget = 0, calls8 = 0;
+  FusionStats free_stats, budget_stats, stats8;
+  const PointCloud free_cloud = run(24, 0, &calls_free, &free_stats);
+  // Room for the pending samples, the cloud and about two maps.
+  const double budget_mb =
+      (2.0 * mb + free_stats.cloud_bytes + 2 * map_bytes) / mb;
+  const PointCloud cloud = run(24, budget_mb, &calls_budget, &budget_stats);
+  std::printf(
+      "no joint budget: peak %zu B, %d map loads; memory_mb %.2f: peak %zu "
+      "B, %d map loads, cloud %zu B\n",
+      free_stats.peak_bytes, calls_free, budget_mb, budget_stats.peak_bytes,
+      calls_budget, budget_stats.cloud_bytes);
+  // The same cloud, point for point.
+  ASSERT_GT(cloud.size(), 10000u);
+  ASSERT_EQ(cloud.size(), free_cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ(cloud.xyz[i], free_cloud.xyz[i]) << i;
+    ASSERT_EQ(cloud.normal[i], free_cloud.normal[i]) << i;
+    ASSERT_EQ(cloud.confidence[i], free_cloud.confidence[i]) << i;
+    ASSERT_EQ(cloud.support[i], free_cloud.support[i]) << i;
+  }
+  // Without it all 24 maps stay (loaded once); with it maps were evicted
+  // and read again.
+  EXPECT_EQ(calls_free, 24);
+  EXPECT_GT(calls_budget, calls_free);
+  EXPECT_GT(free_stats.peak_bytes, 20 * map_bytes);
+  // The peak: the budget plus the maps in use by one AddView (the view's
+  // and one related map) and one view's new pending samples before they
+  // are trimmed.
+  const size_t view_pending = 240 * 180 * 64;
+  EXPECT_LE(budget_stats.peak_bytes,
+            static_cast<size_t>(budget_mb * mb) + 2 * map_bytes + view_pending);
+  EXPECT_LT(budget_stats.peak_bytes, free_stats.peak_bytes / 2);
+  // Flat in the number of views: 8 views under the same budget peak at
+  // nearly the same account (their cloud is smaller, their maps more).
+  run(8, budget_mb, &calls8, &stats8);
+  EXPECT_GT(stats8.peak_bytes, budget_stats.peak_bytes * 8 / 10);
 }
 
 // Masks (0 = ignore), bounding box and minimum confidence filter samples.

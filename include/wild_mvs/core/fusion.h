@@ -100,6 +100,16 @@ struct FusionOptions {
   // oldest views' pending samples are dropped beyond it. 0 = no pending
   // samples (a sample is only checked against views added before it).
   double pending_mb = 256;
+  // Joint budget in megabytes of the fusion's own memory: cached maps +
+  // pending samples + the cloud (points and spatial hash). When > 0, cached
+  // maps are evicted (and read again through the provider when needed) so
+  // that the three stay within it: the cloud takes the maps' room as it
+  // grows, and the fusion's memory stops growing once the budget is full.
+  // Only maps are given up for it (pending samples keep pending_mb, the
+  // cloud is the output), so results do not change; beyond it the account
+  // is pending + cloud + the maps in use. 0 = no joint budget (the maps have
+  // map_cache_mb of their own).
+  double memory_mb = 0;
 
   void Check() const;
 };
@@ -184,6 +194,10 @@ class StreamingFusion {
   void Insert(const Sample& s);
   void TrimPending();
   void UpdatePeak();
+  // Bytes the map cache may hold now (map_cache_mb, and within memory_mb
+  // what pending samples and the cloud leave).
+  size_t MapCap() const;
+  void EvictMaps();
   size_t PendingBytes() const;
   size_t CloudBytes() const;
 

@@ -62,6 +62,11 @@ class ImageCache {
   // The image of `view` resampled to width x height (area averaging when
   // shrinking), cached separately.
   std::shared_ptr<const cv::Mat> GetResized(int view, int width, int height);
+  // The full-resolution image of `view` from the loader, not cached (for a
+  // stage that reads each image once: caching it would only hold memory).
+  cv::Mat Load(int view) const { return loader_(view); }
+  // Drops every cached image (images in use elsewhere live on).
+  void Clear();
 
   size_t bytes() const;
   size_t peak_bytes() const;
