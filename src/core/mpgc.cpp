@@ -194,11 +194,7 @@ void PatchMatcher::InitScales(int slot_index) {
     }
     if (mpgc_.photometric_offset) {
       // Contrast ratio of the mean-free windows.
-      double saa = 0;
-      for (int i = 0; i < npix_; ++i) {
-        const double r = ref_centered_[4 * i + c];
-        saa += r * r;
-      }
+      const double saa = ref_saa_c_[c];
       const double sbb = svv - sv * sv / npix_;
       if (sbb > 1e-12 && saa > 1e-12)
         sl.scale[c] = static_cast<float>(std::sqrt(saa / sbb));
@@ -228,7 +224,9 @@ int PatchMatcher::FillActive() {
       [&](int v, double* ncc) {
         slot = FreeSlot();
         PrepareView(v, slot);
-        if (!SampleSlot(slot, false)) return false;
+        // With the gradient: a view that enters is not sampled again at
+        // this patch (SlotData::fresh).
+        if (!SampleSlot(slot, true)) return false;
         *ncc = SlotNcc(slot);
         return true;
       },
@@ -236,6 +234,7 @@ int PatchMatcher::FillActive() {
         SlotData& sl = slots_[slot];
         sl.ncc = ncc;
         sl.prev_ncc = std::numeric_limits<double>::quiet_NaN();
+        sl.fresh = true;
         InitScales(slot);
         Note(iteration_, MatchTrace::Kind::kEntered, v);
         active_slot_[a] = slot;
@@ -282,13 +281,16 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   for (int c = 0; c < channels_; ++c) {
     const double mean = ref_sum_[c] / npix_;
     double var_c = 0;
+    double saa_c = 0;
     for (int i = 0; i < npix_; ++i) {
       const double d = ref_[4 * i + c] - mean;
       const float df = static_cast<float>(d);
       ref_centered_[4 * i + c] = df;
       var_c += d * d;
       ref_saa_ += static_cast<double>(df) * df;
+      saa_c += static_cast<double>(df) * df;
     }
+    ref_saa_c_[c] = saa_c;
     var_total += var_c;
     if (mpgc_.min_texture_levels > 0)
       levels += std::sqrt(var_c / npix_) * 255.0 / LinearPerSrgb(mean);
@@ -308,6 +310,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
     state_[k] = (!local_.enabled && k >= local_.num_active) ? 2 : 0;
   }
   num_active_ = 0;
+  for (SlotData& sl : slots_) sl.fresh = false;
   return true;
 }
 
@@ -332,6 +335,12 @@ double PatchMatcher::PlaneScore(int s, int t, double depth,
 int PatchMatcher::SampleActive(int first) {
   int left = 0;
   for (int a = first; a < num_active_;) {
+    SlotData& sl = slots_[active_slot_[a]];
+    if (sl.fresh) {  // sampled at this patch when it entered
+      sl.fresh = false;
+      ++a;
+      continue;
+    }
     if (SampleSlot(active_slot_[a], true)) {
       ++a;
       continue;

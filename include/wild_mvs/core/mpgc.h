@@ -181,7 +181,8 @@ class PatchMatcher {
   alignas(64) float wj_[mpgc_kernels::kWindowFloats];    // row offset j
   alignas(64) double oi_[mpgc_kernels::kWindowPixels];   // i per pixel
   alignas(64) double oj_[mpgc_kernels::kWindowPixels];   // j per pixel
-  double ref_saa_ = 0;  // sum of squares of the above
+  double ref_saa_ = 0;   // sum of squares of the above
+  double ref_saa_c_[3];  // the same per channel (InitScales)
   // Candidate state this visit: 0 free, 1 active, 2 rejected.
   uint8_t state_[kMaxNeighbors];
   Eigen::Vector2d epi_dir_[kMaxNeighbors];
@@ -198,6 +199,9 @@ class PatchMatcher {
     alignas(64) float dval[mpgc_kernels::kWindowFloats];  // d sample / d h
     float scale[3];
     double ncc, prev_ncc;
+    // val and dval hold the samples at the current patch (taken when the
+    // view entered A): the next SampleActive skips the slot once.
+    bool fresh = false;
   };
   SlotData slots_[kMaxActive + 1];
 };
