@@ -88,8 +88,13 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
   Require(ctx_.views.size() <= static_cast<size_t>(kMaxNeighbors),
           "PatchMatcher: too many neighbours");
   max_angle_rad_ = local_.max_epipolar_angle_deg * M_PI / 180.0;
-  for (size_t v = 0; v < ctx_.views.size(); ++v)
+  for (size_t v = 0; v < ctx_.views.size(); ++v) {
     global_scores_[v] = ctx_.views[v].global_score;
+    by_global_score_[v] = static_cast<int>(v);
+  }
+  std::stable_sort(
+      by_global_score_, by_global_score_ + ctx_.views.size(),
+      [this](int a, int b) { return global_scores_[a] > global_scores_[b]; });
   // The kernels' constant per-lane tables; every unused lane stays zero.
   constexpr int nf = mpgc_kernels::kWindowFloats;
   std::fill(ref_, ref_ + nf, 0.0f);
@@ -315,13 +320,17 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
 }
 
 double PatchMatcher::PlaneScore(int s, int t, double depth,
-                                const Eigen::Vector3d& normal, int k) {
+                                const Eigen::Vector3d& normal, int k,
+                                int max_views) {
   if (!SetupPixel(s, t, depth, normal)) return -1;
   double best[kMaxNeighbors];
   int count = 0;
   const int slot = kMaxActive;
-  for (size_t v = 0; v < ctx_.views.size(); ++v) {
-    PrepareView(static_cast<int>(v), slot);
+  const int nv = static_cast<int>(ctx_.views.size());
+  const int m = max_views > 0 ? std::min(max_views, nv) : nv;
+  for (int i = 0; i < m; ++i) {
+    const int v = max_views > 0 ? by_global_score_[i] : i;
+    PrepareView(v, slot);
     if (!SampleSlot(slot, false)) continue;
     best[count++] = SlotNcc(slot);
   }

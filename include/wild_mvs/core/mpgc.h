@@ -123,9 +123,11 @@ class PatchMatcher {
              PatchResult* out, MatchTrace* trace = nullptr);
   // Mean of the best `k` NCC scores over N of the window at pixel (s, t) on
   // the plane (depth, normal), without optimisation (for the depth sweep).
-  // Returns -1 when fewer than k views see the window.
+  // max_views > 0: only over the max_views views of the highest global
+  // score (ties: lower index first). Returns -1 when fewer than k views see
+  // the window.
   double PlaneScore(int s, int t, double depth, const Eigen::Vector3d& normal,
-                    int k);
+                    int k, int max_views = 0);
 
   // Whether the window around (s, t) lies inside R's image.
   bool WindowInside(int s, int t) const;
@@ -187,8 +189,9 @@ class PatchMatcher {
   uint8_t state_[kMaxNeighbors];
   Eigen::Vector2d epi_dir_[kMaxNeighbors];
   double global_scores_[kMaxNeighbors];
-  int active_[kMaxActive];       // view indices of A
-  int active_slot_[kMaxActive];  // their scratch slots
+  int by_global_score_[kMaxNeighbors];  // view indices, best global first
+  int active_[kMaxActive];              // view indices of A
+  int active_slot_[kMaxActive];         // their scratch slots
   int num_active_ = 0;
   MatchTrace* trace_ = nullptr;  // this call's, or null
   int iteration_ = 0;            // updates done in this call
