@@ -80,6 +80,8 @@ median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(
   echo "# wild_mvs bench $(date -u +%FT%TZ), commit $(git -C "$ROOT" rev-parse HEAD 2>/dev/null || echo unknown)"
   echo "# host $(uname -n), $(nproc) cores: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-)"
   echo "# threads $THREADS, runs $RUNS, extra args: ${EXTRA[*]+${EXTRA[*]}}"
+  echo "# CPU SIMD flags: $(grep -m1 -o -w 'avx2\|avx512f' /proc/cpuinfo | tr '\n' ' ')"
+  echo "# WILD_MVS_SIMD_TARGET=${WILD_MVS_SIMD_TARGET:-} (empty: the best the CPU has; the log says which)"
 } >"$RESULTS/README.txt"
 
 TSV="$RESULTS/table.tsv"

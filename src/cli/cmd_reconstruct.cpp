@@ -15,6 +15,7 @@
 #include "wild_mvs/cli/reconstruct_config.h"
 #include "wild_mvs/cli/run_steps.h"
 #include "wild_mvs/cli/scene_setup.h"
+#include "wild_mvs/core/mpgc_kernels.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/colmap.h"
 #include "wild_mvs/io/image_files.h"
@@ -309,7 +310,8 @@ void DepthStage(Scene* scene, const std::vector<int>& views, ImageCache& images,
                  r, log);
   }
   log << "depth: " << views.size() << " views, " << todo << " to compute, "
-      << pool->size() << " threads\n";
+      << pool->size() << " threads, SIMD " << mpgc_kernels::KernelTarget()
+      << "\n";
   r->depth = RunDepthStage(*scene, views, images, config, pool, out, force, log,
                            !shard);
   r->depth_ran = true;

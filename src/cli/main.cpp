@@ -3,6 +3,7 @@
 // "wild_mvs <command>: <problem>" and a non-zero exit. Never crashes on bad
 // input.
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include "wild_mvs/cli/args.h"
 #include "wild_mvs/cli/commands.h"
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/mpgc_kernels.h"
 #include "wild_mvs/core/stats.h"
 
 namespace {
@@ -65,6 +67,16 @@ int main(int argc, char** argv) {
   }
   args.erase(args.begin());
   const std::string prefix = std::string("wild_mvs ") + command->name + ": ";
+  // Benchmarks: cap the SIMD kernels' instruction set (e.g. AVX2 on an
+  // AVX-512 CPU, mpgc_kernels.h).
+  if (const char* simd = std::getenv("WILD_MVS_SIMD_TARGET")) {
+    if (*simd && !wild_mvs::mpgc_kernels::LimitTarget(simd)) {
+      std::cerr << prefix << "WILD_MVS_SIMD_TARGET=" << simd
+                << " is not an instruction set of this binary on this CPU"
+                << " (e.g. AVX3, AVX2, SSE4)\n";
+      return 2;
+    }
+  }
   try {
     return command->run(args);
   } catch (const wild_mvs::cli::UsageError& e) {

@@ -94,8 +94,13 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
   Require(ctx_.views.size() <= static_cast<size_t>(kMaxNeighbors),
           "PatchMatcher: too many neighbours");
   max_angle_rad_ = local_.max_epipolar_angle_deg * M_PI / 180.0;
-  for (size_t v = 0; v < ctx_.views.size(); ++v)
+  for (size_t v = 0; v < ctx_.views.size(); ++v) {
     global_scores_[v] = ctx_.views[v].global_score;
+    by_global_score_[v] = static_cast<int>(v);
+  }
+  std::stable_sort(
+      by_global_score_, by_global_score_ + ctx_.views.size(),
+      [this](int a, int b) { return global_scores_[a] > global_scores_[b]; });
   // The kernels' constant per-lane tables; every unused lane stays zero.
   constexpr int nf = mpgc_kernels::kWindowFloats;
   std::fill(ref_, ref_ + nf, 0.0f);
@@ -200,11 +205,7 @@ void PatchMatcher::InitScales(int slot_index) {
     }
     if (mpgc_.photometric_offset) {
       // Contrast ratio of the mean-free windows.
-      double saa = 0;
-      for (int i = 0; i < npix_; ++i) {
-        const double r = ref_centered_[4 * i + c];
-        saa += r * r;
-      }
+      const double saa = ref_saa_c_[c];
       const double sbb = svv - sv * sv / npix_;
       if (sbb > 1e-12 && saa > 1e-12)
         sl.scale[c] = static_cast<float>(std::sqrt(saa / sbb));
@@ -234,7 +235,9 @@ int PatchMatcher::FillActive() {
       [&](int v, double* ncc) {
         slot = FreeSlot();
         PrepareView(v, slot);
-        if (!SampleSlot(slot, false)) return false;
+        // With the gradient: a view that enters is not sampled again at
+        // this patch (SlotData::fresh).
+        if (!SampleSlot(slot, true)) return false;
         *ncc = SlotNcc(slot);
         return true;
       },
@@ -242,6 +245,7 @@ int PatchMatcher::FillActive() {
         SlotData& sl = slots_[slot];
         sl.ncc = ncc;
         sl.prev_ncc = std::numeric_limits<double>::quiet_NaN();
+        sl.fresh = true;
         InitScales(slot);
         Note(iteration_, MatchTrace::Kind::kEntered, v);
         active_slot_[a] = slot;
@@ -288,13 +292,16 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   for (int c = 0; c < channels_; ++c) {
     const double mean = ref_sum_[c] / npix_;
     double var_c = 0;
+    double saa_c = 0;
     for (int i = 0; i < npix_; ++i) {
       const double d = ref_[4 * i + c] - mean;
       const float df = static_cast<float>(d);
       ref_centered_[4 * i + c] = df;
       var_c += d * d;
       ref_saa_ += static_cast<double>(df) * df;
+      saa_c += static_cast<double>(df) * df;
     }
+    ref_saa_c_[c] = saa_c;
     var_total += var_c;
     if (mpgc_.min_texture_levels > 0)
       levels += std::sqrt(var_c / npix_) * 255.0 / LinearPerSrgb(mean);
@@ -314,17 +321,22 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
     state_[k] = (!local_.enabled && k >= local_.num_active) ? 2 : 0;
   }
   num_active_ = 0;
+  for (SlotData& sl : slots_) sl.fresh = false;
   return true;
 }
 
 double PatchMatcher::PlaneScore(int s, int t, double depth,
-                                const Eigen::Vector3d& normal, int k) {
+                                const Eigen::Vector3d& normal, int k,
+                                int max_views) {
   if (!SetupPixel(s, t, depth, normal)) return -1;
   double best[kMaxNeighbors];
   int count = 0;
   const int slot = kMaxActive;
-  for (size_t v = 0; v < ctx_.views.size(); ++v) {
-    PrepareView(static_cast<int>(v), slot);
+  const int nv = static_cast<int>(ctx_.views.size());
+  const int m = max_views > 0 ? std::min(max_views, nv) : nv;
+  for (int i = 0; i < m; ++i) {
+    const int v = max_views > 0 ? by_global_score_[i] : i;
+    PrepareView(v, slot);
     if (!SampleSlot(slot, false)) continue;
     best[count++] = SlotNcc(slot);
   }
@@ -338,6 +350,12 @@ double PatchMatcher::PlaneScore(int s, int t, double depth,
 int PatchMatcher::SampleActive(int first) {
   int left = 0;
   for (int a = first; a < num_active_;) {
+    SlotData& sl = slots_[active_slot_[a]];
+    if (sl.fresh) {  // sampled at this patch when it entered
+      sl.fresh = false;
+      ++a;
+      continue;
+    }
     if (SampleSlot(active_slot_[a], true)) {
       ++a;
       continue;

@@ -10,6 +10,7 @@
 #define HWY_TARGET_INCLUDE "src/core/mpgc_kernels.cpp"
 #include <hwy/foreach_target.h>  // NOLINT: must precede highway.h
 #include <hwy/highway.h>
+#include <hwy/targets.h>
 
 HWY_BEFORE_NAMESPACE();
 namespace wild_mvs {
@@ -505,6 +506,16 @@ void NormalSums(const float* ref, const float* val, const float* dval,
 }
 
 const char* KernelTarget() { return HWY_DYNAMIC_DISPATCH(KernelTargetImpl)(); }
+
+bool LimitTarget(const std::string& name) {
+  for (int64_t t : hwy::SupportedAndGeneratedTargets()) {
+    if (name != hwy::TargetName(t)) continue;
+    // Highway's target bits: a lower bit is a better target.
+    hwy::DisableTargets(t - 1);
+    return true;
+  }
+  return false;
+}
 
 }  // namespace mpgc_kernels
 }  // namespace wild_mvs

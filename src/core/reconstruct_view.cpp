@@ -39,6 +39,8 @@ MvsOptions PaperMvsOptions() {
   o.mpgc.photometric_offset = false;
   o.growing.revisit_margin = 0;
   o.growing.hypotheses = 0;
+  o.growing.start_views = 0;
+  o.growing.start_min_score = -1;
   o.sweep.below_seeds = 0;
   o.consistency.enabled = false;
   o.refine.enabled = false;

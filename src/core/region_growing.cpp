@@ -23,6 +23,12 @@ void RegionGrowingOptions::Check() const {
           " must be in [0, 2] (NCC units)");
   Require(hypotheses >= 0 && hypotheses <= 16,
           "mvs.growing.hypotheses = ", hypotheses, " must be in [0, 16]");
+  Require(start_views >= 0 && start_views <= kMaxNeighbors,
+          "mvs.growing.start_views = ", start_views, " must be in [0, ",
+          kMaxNeighbors, "]");
+  Require(start_min_score >= -1 && start_min_score <= 1,
+          "mvs.growing.start_min_score = ", start_min_score,
+          " must be in [-1, 1]");
 }
 
 double ThreadCpuSeconds() {
@@ -307,6 +313,50 @@ class RegionGrower {
     return false;
   }
 
+  // start_views: the start of the first MPGC at an empty pixel (x, y):
+  // the candidate's copied plane or a reconstructed 4-neighbour's plane,
+  // whichever scores best with the cheap NCC (ties: the copied plane, then
+  // the neighbours in the order +x, -x, +y, -y). False (skip the pixel)
+  // when the best scores below start_min_score.
+  bool PickStart(PatchMatcher* m, int x, int y, const Candidate& c,
+                 double* depth, Eigen::Vector3d* normal) {
+    *depth = c.depth;
+    *normal = Eigen::Vector3d(c.normal[0], c.normal[1], c.normal[2]);
+    double hd[4];
+    Eigen::Vector3d hn[4];
+    int nh = 0;
+    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    for (int k = 0; k < 4; ++k) {
+      const int nx = x + dx[k], ny = y + dy[k];
+      if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
+      const int q = ny * W_ + nx;
+      if (!(dmap_[q] > 0) || !(cmap_[q] > 0)) continue;
+      const Eigen::Vector3d nq(nmap_[3 * q], nmap_[3 * q + 1],
+                               nmap_[3 * q + 2]);
+      const Eigen::Vector3d Xq =
+          cam_.BackprojectCam(Eigen::Vector2d(nx + 0.5, ny + 0.5), dmap_[q]);
+      const double d = PlaneDepthAt(cam_, x, y, Xq, nq, dmap_[q]);
+      if (!(d > 0) || !std::isfinite(d)) continue;
+      // The plane the candidate was copied from (float-rounded): no new
+      // hypothesis.
+      if (std::abs(d - c.depth) <= 1e-5 * d && nq.dot(*normal) > 1 - 1e-6)
+        continue;
+      hd[nh] = d;
+      hn[nh++] = nq;
+    }
+    if (nh == 0 && !(opt_.start_min_score > -1)) return true;
+    double best = m->PlaneScore(x, y, *depth, *normal, 2, opt_.start_views);
+    for (int i = 0; i < nh; ++i) {
+      const double sc = m->PlaneScore(x, y, hd[i], hn[i], 2, opt_.start_views);
+      if (sc > best) {
+        best = sc;
+        *depth = hd[i];
+        *normal = hn[i];
+      }
+    }
+    return !(opt_.start_min_score > -1) || best >= opt_.start_min_score;
+  }
+
   // Best-first growth inside one tile: pop, match, store, push the four
   // neighbours with the same plane (those of other tiles to this tile's
   // outbox).
@@ -333,9 +383,12 @@ class RegionGrower {
       if (!WorthVisit(p, c.conf)) continue;
       const int x = p % W_, y = p / W_;
       ++visits_[tile];
-      if (!m->Match(x, y, c.depth,
-                    Eigen::Vector3d(c.normal[0], c.normal[1], c.normal[2]),
-                    &r) &&
+      double start_depth = c.depth;
+      Eigen::Vector3d start_normal(c.normal[0], c.normal[1], c.normal[2]);
+      if (opt_.start_views > 0 && !(cmap_[p] > 0) &&
+          !PickStart(m.get(), x, y, c, &start_depth, &start_normal))
+        continue;
+      if (!m->Match(x, y, start_depth, start_normal, &r) &&
           !(opt_.hypotheses > 0 && !(cmap_[p] > 0) &&
             MatchFromHypotheses(m.get(), x, y, c, &r, &visits_[tile])))
         continue;
@@ -469,6 +522,19 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "NCC; 0 = paper")
       .Min(0)
       .Max(16);
+  registry
+      ->Add(key("start_views"), &o->start_views,
+            "before the first MPGC at an empty pixel, start from the best of "
+            "the copied plane and the 4-neighbours' planes by NCC over this "
+            "many views (best global score); 0 = off (paper)")
+      .Min(0)
+      .Max(kMaxNeighbors);
+  registry
+      ->Add(key("start_min_score"), &o->start_min_score,
+            "with start_views: skip the pixel when the best start's NCC (mean "
+            "of the best 2) is below this; -1 = off")
+      .Min(-1)
+      .Max(1);
 }
 
 }  // namespace wild_mvs

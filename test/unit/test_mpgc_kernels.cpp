@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <opencv2/core.hpp>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "synthetic_scene.h"
@@ -205,6 +206,21 @@ TEST(MpgcKernels, VectorTargetsMatchScalar) {
               compared, outside, targets.size());
   EXPECT_GT(compared, 100);
   EXPECT_GT(outside, 0);
+}
+
+// WILD_MVS_SIMD_TARGET (mpgc_kernels::LimitTarget): capping at each target
+// the binary has for this CPU makes the kernels dispatch to exactly it; an
+// unknown name changes nothing.
+TEST(MpgcKernels, LimitTargetCapsTheDispatch) {
+  const std::string best = mk::KernelTarget();
+  EXPECT_FALSE(mk::LimitTarget("NOPE"));
+  EXPECT_EQ(mk::KernelTarget(), best);
+  for (int64_t t : hwy::SupportedAndGeneratedTargets()) {  // best first
+    ASSERT_TRUE(mk::LimitTarget(hwy::TargetName(t)));
+    EXPECT_STREQ(mk::KernelTarget(), hwy::TargetName(t));
+  }
+  hwy::DisableTargets(0);  // back to the CPU's best
+  EXPECT_EQ(mk::KernelTarget(), best);
 }
 
 // A whole view reconstructed with the best vector target and with

@@ -138,9 +138,11 @@ class PatchMatcher {
              PatchResult* out, MatchTrace* trace = nullptr);
   // Mean of the best `k` NCC scores over N of the window at pixel (s, t) on
   // the plane (depth, normal), without optimisation (for the depth sweep).
-  // Returns -1 when fewer than k views see the window.
+  // max_views > 0: only over the max_views views of the highest global
+  // score (ties: lower index first). Returns -1 when fewer than k views see
+  // the window.
   double PlaneScore(int s, int t, double depth, const Eigen::Vector3d& normal,
-                    int k);
+                    int k, int max_views = 0);
 
   // Whether the window around (s, t) lies inside R's image.
   bool WindowInside(int s, int t) const;
@@ -199,13 +201,15 @@ class PatchMatcher {
   alignas(64) float wj_[mpgc_kernels::kWindowFloats];    // row offset j
   alignas(64) double oi_[mpgc_kernels::kWindowPixels];   // i per pixel
   alignas(64) double oj_[mpgc_kernels::kWindowPixels];   // j per pixel
-  double ref_saa_ = 0;  // sum of squares of the above
+  double ref_saa_ = 0;   // sum of squares of the above
+  double ref_saa_c_[3];  // the same per channel (InitScales)
   // Candidate state this visit: 0 free, 1 active, 2 rejected.
   uint8_t state_[kMaxNeighbors];
   Eigen::Vector2d epi_dir_[kMaxNeighbors];
   double global_scores_[kMaxNeighbors];
-  int active_[kMaxActive];       // view indices of A
-  int active_slot_[kMaxActive];  // their scratch slots
+  int by_global_score_[kMaxNeighbors];  // view indices, best global first
+  int active_[kMaxActive];              // view indices of A
+  int active_slot_[kMaxActive];         // their scratch slots
   int num_active_ = 0;
   MatchTrace* trace_ = nullptr;  // this call's, or null
   int iteration_ = 0;            // updates done in this call
@@ -216,6 +220,9 @@ class PatchMatcher {
     alignas(64) float dval[mpgc_kernels::kWindowFloats];  // d sample / d h
     float scale[3];
     double ncc, prev_ncc;
+    // val and dval hold the samples at the current patch (taken when the
+    // view entered A): the next SampleActive skips the slot once.
+    bool fresh = false;
   };
   SlotData slots_[kMaxActive + 1];
 };

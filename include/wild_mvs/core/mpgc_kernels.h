@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "wild_mvs/core/patch.h"
 
@@ -79,6 +80,13 @@ void NormalSums(const float* ref, const float* val, const float* dval,
 
 // Name of the instruction set the kernels dispatch to (e.g. "AVX3").
 const char* KernelTarget();
+
+// Caps the instruction set the kernels dispatch to at `name` (a Highway
+// target name as KernelTarget() prints it, e.g. "AVX2" on an AVX-512 CPU:
+// to measure what a CPU without AVX-512 gets): every better target is
+// disabled for the process. False (nothing changed) when this binary has
+// no such target for this CPU. Call before the kernels run.
+bool LimitTarget(const std::string& name);
 
 }  // namespace mpgc_kernels
 }  // namespace wild_mvs

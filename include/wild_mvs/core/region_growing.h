@@ -43,6 +43,16 @@ struct RegionGrowingOptions {
   // are scored with the NCC of the unoptimised window and MPGC runs from
   // the best this many of them (scoring above mpgc.drop_ncc). 0 = paper.
   int hypotheses = 0;
+  // (beyond the paper, PatchMatch-style; issue 12) Before the first MPGC at
+  // a pixel that holds nothing yet, the plane copied from the popped
+  // neighbour and the planes of the pixel's other reconstructed
+  // 4-neighbours are scored with the NCC of the unoptimised window (mean of
+  // the best 2 over the start_views views of the highest global score) and
+  // MPGC starts from the best. 0 = off: start from the copied plane (paper).
+  int start_views = 0;
+  // With start_views > 0: no MPGC at all when the best start scores below
+  // this (NCC units). -1 = off (always match).
+  double start_min_score = -1;
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h), e.g. "mvs.growing".
