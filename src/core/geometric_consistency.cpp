@@ -18,6 +18,8 @@ void GeometricConsistencyOptions::Check() const {
   Require(max_relative_depth > 0 && max_relative_depth < 1,
           "mvs.consistency.max_relative_depth = ", max_relative_depth,
           " must be in (0, 1)");
+  Require(search_px >= 0 && search_px <= 3,
+          "mvs.consistency.search_px = ", search_px, " must be in [0, 3]");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -43,19 +45,21 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "relative depth difference allowed")
       .Above(0)
       .Below(1);
+  registry
+      ->Add(key("search_px"), &o->search_px,
+            "also try the neighbour's pixels within this many pixels of the "
+            "projection (0 = only the pixel containing it)")
+      .Min(0)
+      .Max(3);
 }
 
 namespace {
 
-// Whether neighbour map `nb` confirms depth z at pixel (x, y) of ref.
-bool Confirms(const Camera& rc, const DepthMap& nb, int x, int y, double z,
-              const GeometricConsistencyOptions& o) {
-  const Eigen::Vector2d p(x + 0.5, y + 0.5);
-  const Eigen::Vector3d X = rc.Backproject(p, z);
-  Eigen::Vector2d q;
-  if (!nb.camera.Project(X, &q)) return false;
-  const int qx = static_cast<int>(std::floor(q.x()));
-  const int qy = static_cast<int>(std::floor(q.y()));
+// Whether the depth of pixel (qx, qy) of neighbour map `nb`, reprojected
+// into R, lands within the tolerances of (p, z).
+bool RoundTrips(const Camera& rc, const DepthMap& nb, int qx, int qy,
+                const Eigen::Vector2d& p, double z,
+                const GeometricConsistencyOptions& o) {
   if (qx < 0 || qy < 0 || qx >= nb.width() || qy >= nb.height()) return false;
   const float zv = nb.depth.at<float>(qy, qx);
   if (!(zv > 0)) return false;
@@ -66,6 +70,25 @@ bool Confirms(const Camera& rc, const DepthMap& nb, int x, int y, double z,
   const double zb = rc.Depth(Y);
   return (pb - p).norm() <= o.max_reprojection_px &&
          std::abs(zb - z) <= o.max_relative_depth * z;
+}
+
+// Whether neighbour map `nb` confirms depth z at pixel (x, y) of ref: the
+// pixel of nb containing the projection q, or with search_px > 0 any pixel
+// of nb within search_px of it.
+bool Confirms(const Camera& rc, const DepthMap& nb, int x, int y, double z,
+              const GeometricConsistencyOptions& o) {
+  const Eigen::Vector2d p(x + 0.5, y + 0.5);
+  const Eigen::Vector3d X = rc.Backproject(p, z);
+  Eigen::Vector2d q;
+  if (!nb.camera.Project(X, &q)) return false;
+  const int qx = static_cast<int>(std::floor(q.x()));
+  const int qy = static_cast<int>(std::floor(q.y()));
+  if (RoundTrips(rc, nb, qx, qy, p, z, o)) return true;
+  for (int dy = -o.search_px; dy <= o.search_px; ++dy)
+    for (int dx = -o.search_px; dx <= o.search_px; ++dx)
+      if ((dx != 0 || dy != 0) && RoundTrips(rc, nb, qx + dx, qy + dy, p, z, o))
+        return true;
+  return false;
 }
 
 }  // namespace

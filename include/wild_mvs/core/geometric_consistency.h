@@ -27,6 +27,10 @@ struct GeometricConsistencyOptions {
   int min_consistent = 1;
   double max_reprojection_px = 1.0;  // forward-backward distance in R
   double max_relative_depth = 0.01;  // |z' - z| / z
+  // Pixels of V tried around the one containing q: 0 = that pixel only; 1 =
+  // its 3x3 neighbourhood (any of them confirming is enough), which forgives
+  // the up to 0.7 px between q and the centre of the pixel containing it.
+  int search_px = 0;
   void Check() const;
 };
 
