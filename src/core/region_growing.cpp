@@ -263,6 +263,31 @@ class RegionGrower {
     return !(have > 0) || (have < conf && conf - have > margin_);
   }
 
+  // The planes of (x, y)'s reconstructed 4-neighbours (order +x, -x, +y,
+  // -y), each carried to (x, y): its depth there and its normal. With
+  // `matched_only`, neighbours without a confidence (held seeds) are left
+  // out. Returns how many (<= 4).
+  int NeighbourPlanes(int x, int y, bool matched_only, double depth[4],
+                      Eigen::Vector3d normal[4]) const {
+    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    int n = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int nx = x + dx[k], ny = y + dy[k];
+      if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
+      const int q = ny * W_ + nx;
+      if (!(dmap_[q] > 0) || (matched_only && !(cmap_[q] > 0))) continue;
+      const Eigen::Vector3d nq(nmap_[3 * q], nmap_[3 * q + 1],
+                               nmap_[3 * q + 2]);
+      const Eigen::Vector3d Xq =
+          cam_.BackprojectCam(Eigen::Vector2d(nx + 0.5, ny + 0.5), dmap_[q]);
+      const double d = PlaneDepthAt(cam_, x, y, Xq, nq, dmap_[q]);
+      if (!(d > 0) || !std::isfinite(d)) continue;
+      depth[n] = d;
+      normal[n++] = nq;
+    }
+    return n;
+  }
+
   // Beyond the paper: when MPGC from the copied plane fails at (x, y), the
   // planes of p's reconstructed 4-neighbours and perturbations of the
   // copied plane are scored with the cheap NCC (no optimisation), and MPGC
@@ -282,18 +307,10 @@ class RegionGrower {
       const double score = m->PlaneScore(x, y, depth, n, 2);
       if (score > min_score_) hyps[nh++] = {score, depth, n};
     };
-    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
-    for (int k = 0; k < 4; ++k) {
-      const int nx = x + dx[k], ny = y + dy[k];
-      if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
-      const int q = ny * W_ + nx;
-      if (!(dmap_[q] > 0)) continue;
-      const Eigen::Vector3d nq(nmap_[3 * q], nmap_[3 * q + 1],
-                               nmap_[3 * q + 2]);
-      const Eigen::Vector3d Xq =
-          cam_.BackprojectCam(Eigen::Vector2d(nx + 0.5, ny + 0.5), dmap_[q]);
-      add(PlaneDepthAt(cam_, x, y, Xq, nq, dmap_[q]), nq);
-    }
+    double nd[4];
+    Eigen::Vector3d nn[4];
+    const int nnb = NeighbourPlanes(x, y, false, nd, nn);
+    for (int i = 0; i < nnb; ++i) add(nd[i], nn[i]);
     // Perturbations: depth +-1 % and the normal tilted by 15 degrees about
     // the image axes (deterministic: no random numbers).
     for (double f : {0.99, 1.01}) add(c.depth * f, cn);
@@ -322,27 +339,18 @@ class RegionGrower {
                  double* depth, Eigen::Vector3d* normal) {
     *depth = c.depth;
     *normal = Eigen::Vector3d(c.normal[0], c.normal[1], c.normal[2]);
-    double hd[4];
-    Eigen::Vector3d hn[4];
+    double nd[4], hd[4];
+    Eigen::Vector3d nn[4], hn[4];
     int nh = 0;
-    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
-    for (int k = 0; k < 4; ++k) {
-      const int nx = x + dx[k], ny = y + dy[k];
-      if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
-      const int q = ny * W_ + nx;
-      if (!(dmap_[q] > 0) || !(cmap_[q] > 0)) continue;
-      const Eigen::Vector3d nq(nmap_[3 * q], nmap_[3 * q + 1],
-                               nmap_[3 * q + 2]);
-      const Eigen::Vector3d Xq =
-          cam_.BackprojectCam(Eigen::Vector2d(nx + 0.5, ny + 0.5), dmap_[q]);
-      const double d = PlaneDepthAt(cam_, x, y, Xq, nq, dmap_[q]);
-      if (!(d > 0) || !std::isfinite(d)) continue;
+    const int nnb = NeighbourPlanes(x, y, true, nd, nn);
+    for (int i = 0; i < nnb; ++i) {
       // The plane the candidate was copied from (float-rounded): no new
       // hypothesis.
-      if (std::abs(d - c.depth) <= 1e-5 * d && nq.dot(*normal) > 1 - 1e-6)
+      if (std::abs(nd[i] - c.depth) <= 1e-5 * nd[i] &&
+          nn[i].dot(*normal) > 1 - 1e-6)
         continue;
-      hd[nh] = d;
-      hn[nh++] = nq;
+      hd[nh] = nd[i];
+      hn[nh++] = nn[i];
     }
     if (nh == 0 && !(opt_.start_min_score > -1)) return true;
     double best = m->PlaneScore(x, y, *depth, *normal, 2, opt_.start_views);
