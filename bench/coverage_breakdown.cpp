@@ -19,8 +19,10 @@
 // Also the estimates without ground truth (background) in raw and final,
 // and per extra folder given by --also (e.g. filtered1, refined) its
 // coverage.
+// With --dump-gt DIR, the ground truth of every view at the working
+// resolution is written to DIR/STEM.pfm (for analyses outside this tool).
 //   coverage_breakdown DATASET OUT [--border 2] [--min-views 3]
-//       [--also DIR1,DIR2]
+//       [--also DIR1,DIR2] [--dump-gt DIR]
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -33,6 +35,7 @@
 #include "wild_mvs/io/dataset.h"
 #include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/ground_truth.h"
+#include "wild_mvs/io/pfm.h"
 
 using namespace wild_mvs;
 namespace fs = std::filesystem;
@@ -41,14 +44,16 @@ int main(int argc, char** argv) {
   try {
     Require(argc >= 3,
             "usage: coverage_breakdown DATASET OUT [--border B] "
-            "[--min-views V] [--also DIR,...]");
+            "[--min-views V] [--also DIR,...] [--dump-gt DIR]");
     const std::string dataset = argv[1], out = argv[2];
     int border = 2, min_views = 3;
     std::vector<std::string> also;
+    std::string dump_gt;
     for (int i = 3; i + 1 < argc; i += 2) {
       const std::string k = argv[i], v = argv[i + 1];
       if (k == "--border") border = std::stoi(v);
       if (k == "--min-views") min_views = std::stoi(v);
+      if (k == "--dump-gt") dump_gt = v;
       if (k == "--also") {
         std::stringstream ss(v);
         std::string d;
@@ -74,6 +79,10 @@ int main(int argc, char** argv) {
       fin[it->second] = ReadDepthMapFiles(out, stem);
       gt[it->second] = LoadGroundTruthDepthForView(
           dataset, scene.views[it->second], fin[it->second].map.camera);
+      if (!dump_gt.empty() && !gt[it->second].empty()) {
+        fs::create_directories(dump_gt);
+        WritePfm(dump_gt + "/" + stem + ".pfm", gt[it->second]);
+      }
     }
     const char* names[] = {"final_ok",    "final_bad",   "removed_ok",
                            "removed_bad", "none_border", "none_few_views",

@@ -20,6 +20,10 @@ void GeometricConsistencyOptions::Check() const {
           " must be in (0, 1)");
   Require(search_px >= 0 && search_px <= 3,
           "mvs.consistency.search_px = ", search_px, " must be in [0, 3]");
+  Require(free_space_margin == -1 ||
+              (free_space_margin >= 0 && free_space_margin < 1),
+          "mvs.consistency.free_space_margin = ", free_space_margin,
+          " must be -1 (off) or in [0, 1)");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -51,6 +55,14 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "projection (0 = only the pixel containing it)")
       .Min(0)
       .Max(3);
+  registry
+      ->Add(key("free_space_margin"), &o->free_space_margin,
+            "count a neighbour whose depth lies beyond the sample by more "
+            "than this relative margin as a violation (it sees through the "
+            "sample); a sample needs at least as many confirmations as "
+            "violations; -1 = off")
+      .Min(-1)
+      .Below(1);
 }
 
 namespace {
@@ -72,47 +84,64 @@ bool RoundTrips(const Camera& rc, const DepthMap& nb, int qx, int qy,
          std::abs(zb - z) <= o.max_relative_depth * z;
 }
 
-// Whether neighbour map `nb` confirms depth z at pixel (x, y) of ref: the
-// pixel of nb containing the projection q, or with search_px > 0 any pixel
-// of nb within search_px of it.
-bool Confirms(const Camera& rc, const DepthMap& nb, int x, int y, double z,
+enum class Verdict { kNone, kConfirms, kViolates };
+
+// What neighbour map `nb` says of depth z at pixel (x, y) of ref: it
+// confirms it when the pixel of nb containing the projection q (or, with
+// search_px > 0, any pixel of nb within search_px of it) round-trips; else
+// it violates it when free_space_margin >= 0 and nb's depth at q lies
+// beyond X by more than the margin.
+Verdict Judge(const Camera& rc, const DepthMap& nb, int x, int y, double z,
               const GeometricConsistencyOptions& o) {
   const Eigen::Vector2d p(x + 0.5, y + 0.5);
   const Eigen::Vector3d X = rc.Backproject(p, z);
   Eigen::Vector2d q;
-  if (!nb.camera.Project(X, &q)) return false;
+  if (!nb.camera.Project(X, &q)) return Verdict::kNone;
   const int qx = static_cast<int>(std::floor(q.x()));
   const int qy = static_cast<int>(std::floor(q.y()));
-  if (RoundTrips(rc, nb, qx, qy, p, z, o)) return true;
+  if (RoundTrips(rc, nb, qx, qy, p, z, o)) return Verdict::kConfirms;
   for (int dy = -o.search_px; dy <= o.search_px; ++dy)
     for (int dx = -o.search_px; dx <= o.search_px; ++dx)
       if ((dx != 0 || dy != 0) && RoundTrips(rc, nb, qx + dx, qy + dy, p, z, o))
-        return true;
-  return false;
+        return Verdict::kConfirms;
+  if (o.free_space_margin >= 0 && qx >= 0 && qy >= 0 && qx < nb.width() &&
+      qy < nb.height()) {
+    const float zv = nb.depth.at<float>(qy, qx);
+    if (zv > 0 && zv > (1 + o.free_space_margin) * nb.camera.Depth(X))
+      return Verdict::kViolates;
+  }
+  return Verdict::kNone;
 }
 
 }  // namespace
 
 cv::Mat CountConsistentViews(const DepthMap& ref,
                              const std::vector<const DepthMap*>& neighbors,
-                             const GeometricConsistencyOptions& options) {
+                             const GeometricConsistencyOptions& options,
+                             cv::Mat* violations) {
   options.Check();
   Require(!ref.empty() && ref.depth.type() == CV_32F,
           "CountConsistentViews: empty reference depth map");
   cv::Mat count = cv::Mat::zeros(ref.height(), ref.width(), CV_8U);
+  cv::Mat seen_through = cv::Mat::zeros(ref.height(), ref.width(), CV_8U);
   for (int y = 0; y < ref.height(); ++y) {
     const float* d = ref.depth.ptr<float>(y);
     uint8_t* c = count.ptr<uint8_t>(y);
+    uint8_t* v = seen_through.ptr<uint8_t>(y);
     for (int x = 0; x < ref.width(); ++x) {
       if (!(d[x] > 0)) continue;
-      int n = 0;
-      for (const DepthMap* nb : neighbors)
-        if (nb && !nb->empty() &&
-            Confirms(ref.camera, *nb, x, y, d[x], options))
-          ++n;
+      int n = 0, m = 0;
+      for (const DepthMap* nb : neighbors) {
+        if (!nb || nb->empty()) continue;
+        const Verdict j = Judge(ref.camera, *nb, x, y, d[x], options);
+        n += j == Verdict::kConfirms;
+        m += j == Verdict::kViolates;
+      }
       c[x] = static_cast<uint8_t>(std::min(n, 255));
+      v[x] = static_cast<uint8_t>(std::min(m, 255));
     }
   }
+  if (violations) *violations = seen_through;
   return count;
 }
 
@@ -133,10 +162,13 @@ void FilterByConsistency(DepthMap* ref,
   bool any = false;
   for (const DepthMap* nb : neighbors) any = any || (nb && !nb->empty());
   if (options.enabled && any && st.samples > 0) {
-    const cv::Mat count = CountConsistentViews(*ref, neighbors, options);
+    cv::Mat violations;
+    const cv::Mat count =
+        CountConsistentViews(*ref, neighbors, options, &violations);
     st.kept = 0;
     for (int y = 0; y < ref->height(); ++y) {
       const uint8_t* c = count.ptr<uint8_t>(y);
+      const uint8_t* v = violations.ptr<uint8_t>(y);
       float* d = ref->depth.ptr<float>(y);
       cv::Vec3f* n = ref->normal.ptr<cv::Vec3f>(y);
       float* f = ref->confidence.ptr<float>(y);
@@ -144,7 +176,8 @@ void FilterByConsistency(DepthMap* ref,
       for (int x = 0; x < ref->width(); ++x) {
         if (!(d[x] > 0)) continue;
         const bool is_new = e && e[x] != d[x];
-        if (c[x] >= (is_new ? need_new : options.min_consistent)) {
+        if (c[x] >= (is_new ? need_new : options.min_consistent) &&
+            v[x] <= c[x]) {
           ++st.kept;
           continue;
         }

@@ -24,10 +24,18 @@ double LinearPerSrgb(double v) {
 
 }  // namespace
 
+int AutoWindowStep(int step, int width, int height) {
+  if (step > 0) return step;
+  return std::max(width, height) >= kWideWindowFromPx ? 2 : 1;
+}
+
 void MpgcOptions::Check() const {
   Require(window >= 3 && window <= kMaxWindow && window % 2 == 1,
           "mvs.mpgc.window = ", window, " must be odd and in [3, ", kMaxWindow,
           "]");
+  Require(window_step >= 0 && window_step <= 4,
+          "mvs.mpgc.window_step = ", window_step,
+          " must be in [0, 4] (0 = by image size)");
   Require(settle_iterations >= 0,
           "mvs.mpgc.settle_iterations = ", settle_iterations, " must be >= 0");
   Require(drop_ncc >= -1 && drop_ncc <= 1, "mvs.mpgc.drop_ncc = ", drop_ncc,
@@ -82,7 +90,10 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
           "mvs.mpgc.min_active_views = ", mpgc_.min_active_views,
           " must not exceed mvs.local.num_active = ", local_.num_active);
   n_ = mpgc_.window;
+  step_ = AutoWindowStep(mpgc_.window_step, ctx_.ref_image.width,
+                         ctx_.ref_image.height);
   half_ = n_ / 2;
+  reach_ = half_ * step_;
   npix_ = n_ * n_;
   channels_ = ctx_.ref_image.channels;
   Require(channels_ == 1 || channels_ == 3, "PatchMatcher: ", channels_,
@@ -110,8 +121,8 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
   std::fill(wj_, wj_ + nf, 0.0f);
   for (int k = 0; k < mpgc_kernels::kWindowPixels; ++k) {
     const int p = k < npix_ ? k : 0;  // padding repeats pixel 0
-    oi_[k] = p % n_ - half_;
-    oj_[k] = p / n_ - half_;
+    oi_[k] = (p % n_ - half_) * step_;
+    oj_[k] = (p / n_ - half_) * step_;
   }
   for (int k = 0; k < npix_; ++k)
     for (int c = 0; c < 4; ++c) {
@@ -126,8 +137,9 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
 }
 
 bool PatchMatcher::WindowInside(int s, int t) const {
-  return s - half_ >= 0 && t - half_ >= 0 && s + half_ < ctx_.ref_image.width &&
-         t + half_ < ctx_.ref_image.height;
+  return s - reach_ >= 0 && t - reach_ >= 0 &&
+         s + reach_ < ctx_.ref_image.width &&
+         t + reach_ < ctx_.ref_image.height;
 }
 
 // Precomputes the window's rays mapped into view v.
@@ -135,9 +147,9 @@ bool PatchMatcher::PrepareView(int v, int slot_index) {
   SlotData& sl = slots_[slot_index];
   sl.view = v;
   const Eigen::Matrix3d& A = ctx_.views[v].A;
-  const double u0 = s_ + 0.5 - half_, v0 = t_ + 0.5 - half_;
+  const double u0 = s_ + 0.5 - reach_, v0 = t_ + 0.5 - reach_;
   const Eigen::Vector3d base = A * Eigen::Vector3d(u0, v0, 1.0);
-  const Eigen::Vector3d cu = A.col(0), cv = A.col(1);
+  const Eigen::Vector3d cu = step_ * A.col(0), cv = step_ * A.col(1);
   mpgc_kernels::WindowRays& r = sl.rays;
   int idx = 0;
   for (int j = 0; j < n_; ++j) {
@@ -274,17 +286,18 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   for (int c = 0; c < 3; ++c) ref_sum_[c] = 0;
   double var_total = 0;
   ref_saa_ = 0;
-  for (int j = -half_; j <= half_; ++j) {
+  for (int j = -reach_; j <= reach_; j += step_) {
     const float* row =
         ri.data +
-        (static_cast<size_t>(t + j) * ri.width + (s - half_)) * channels_;
+        (static_cast<size_t>(t + j) * ri.width + (s - reach_)) * channels_;
     const double y = (t + j + 0.5 - cam.cy) / cam.fy;
     for (int i = 0; i < n_; ++i, ++idx) {
-      const double x = (s - half_ + i + 0.5 - cam.cx) / cam.fx;
+      const int di = i * step_;  // pixels right of the window's left edge
+      const double x = (s - reach_ + di + 0.5 - cam.cx) / cam.fx;
       inv_norm_[idx] = 1.0 / std::sqrt(x * x + y * y + 1.0);
       for (int c = 0; c < channels_; ++c) {
-        ref_[4 * idx + c] = row[i * channels_ + c];
-        ref_sum_[c] += row[i * channels_ + c];
+        ref_[4 * idx + c] = row[di * channels_ + c];
+        ref_sum_[c] += row[di * channels_ + c];
       }
     }
   }
@@ -693,6 +706,13 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(3)
       .Max(kMaxWindow)
       .Odd();
+  registry
+      ->Add(key("window_step"), &o->window_step,
+            "pixels between the window's samples (footprint (n - 1) * step "
+            "+ 1; paper: 1); 0 = 2 for working images of 1200 px or more "
+            "on the longer side, else 1")
+      .Min(0)
+      .Max(4);
   registry
       ->Add(key("settle_iterations"), &o->settle_iterations,
             "iterations before any test (paper: 5)")

@@ -37,12 +37,17 @@ MvsOptions PaperMvsOptions() {
   o.mpgc.normal_step_halvings = 0;
   o.mpgc.forecast_iteration = -1;
   o.mpgc.photometric_offset = false;
+  o.mpgc.window = 5;
+  o.mpgc.window_step = 1;
   o.growing.revisit_margin = 0;
   o.growing.hypotheses = 0;
   o.growing.start_views = 0;
   o.growing.start_min_score = -1;
+  o.growing.expand_min_ncc = -1;
   o.sweep.below_seeds = 0;
   o.consistency.enabled = false;
+  o.consistency.search_px = 0;
+  o.consistency.free_space_margin = -1;
   o.refine.enabled = false;
   return o;
 }

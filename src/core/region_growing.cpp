@@ -29,6 +29,9 @@ void RegionGrowingOptions::Check() const {
   Require(start_min_score >= -1 && start_min_score <= 1,
           "mvs.growing.start_min_score = ", start_min_score,
           " must be in [-1, 1]");
+  Require(expand_min_ncc >= -1 && expand_min_ncc <= 1,
+          "mvs.growing.expand_min_ncc = ", expand_min_ncc,
+          " must be in [-1, 1]");
 }
 
 double ThreadCpuSeconds() {
@@ -132,7 +135,8 @@ class RegionGrower {
         visits_(ntx_ * nty_, 0),
         // Given in NCC units; confidence = (NCC + 1) / 2.
         margin_(static_cast<float>(0.5 * options.revisit_margin)),
-        min_score_(mpgc.drop_ncc) {
+        min_score_(mpgc.drop_ncc),
+        expand_conf_(static_cast<float>(0.5 * (options.expand_min_ncc + 1))) {
     if (!mask.empty()) mask_ = mask.isContinuous() ? mask : mask.clone();
     mmap_ = mask_.empty() ? nullptr : mask_.ptr<uint8_t>();
     dmap_ = depth->ptr<float>();
@@ -406,6 +410,7 @@ class RegionGrower {
       dmap_[p] = static_cast<float>(r.depth);
       for (int k = 0; k < 3; ++k)
         nmap_[3 * p + k] = static_cast<float>(r.normal[k]);
+      if (conf < expand_conf_) continue;  // stored, not expanded
       const Eigen::Vector3d X0 =
           cam_.BackprojectCam(Eigen::Vector2d(x + 0.5, y + 0.5), r.depth);
       static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
@@ -456,6 +461,7 @@ class RegionGrower {
   std::vector<long long> visits_;
   const float margin_;
   const double min_score_;
+  const float expand_conf_;  // confidence below which a match does not expand
   cv::Mat mask_;
   const uint8_t* mmap_ = nullptr;
   float* dmap_ = nullptr;
@@ -541,6 +547,12 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("start_min_score"), &o->start_min_score,
             "with start_views: skip the pixel when the best start's NCC (mean "
             "of the best 2) is below this; -1 = off")
+      .Min(-1)
+      .Max(1);
+  registry
+      ->Add(key("expand_min_ncc"), &o->expand_min_ncc,
+            "a match whose mean NCC is below this is kept but does not "
+            "queue its neighbours; -1 = every match expands (paper)")
       .Min(-1)
       .Max(1);
 }

@@ -40,6 +40,18 @@ wait_for_topic() {
   return 1
 }
 
+# wait_for_service NAME [SECONDS=20]: until rosservice lists NAME (a node
+# advertises its services after its topics; on a loaded machine the gap
+# can be seconds)
+wait_for_service() {
+  local t=${2:-20} i
+  for i in $(seq $((t * 5))); do
+    rosservice list 2>/dev/null | grep -qx "$1" && return 0
+    sleep 0.2
+  done
+  return 1
+}
+
 # stop PID NAME: SIGINT, and the process must end by itself within 10 s
 stop() {
   kill -INT "$1" 2>/dev/null || fail "$2 is not running"

@@ -40,7 +40,7 @@ rosrun wild_mvs fusion_node >"$TMP/fusion_node.log" 2>&1 &
 fusion=$!; PIDS+=($fusion)
 wait_for_topic /depth_node/depth_view || fail "rosrun wild_mvs depth_node: no /depth_node/depth_view"
 wait_for_topic /fusion_node/cloud || fail "rosrun wild_mvs fusion_node: no /fusion_node/cloud"
-rosservice list 2>/dev/null | grep -qx /fusion_node/save || fail "no /fusion_node/save service"
+wait_for_service /fusion_node/save || fail "no /fusion_node/save service"
 stop "$depth" depth_node
 stop "$fusion" fusion_node
 echo "ok: rosrun depth_node, fusion_node"

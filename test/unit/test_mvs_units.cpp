@@ -115,9 +115,10 @@ struct MpgcGridStats {
 // MPGC from a wrong start (3 % too far, fronto-parallel) on a 4 x 3 grid of
 // pixels of the slanted plane, window n.
 MpgcGridStats RunMpgcGrid(const SyntheticScene& s, int ref, int n,
-                          bool offset = false) {
+                          bool offset = false, int step = 1) {
   MpgcOptions mo;
   mo.window = n;
+  mo.window_step = step;
   // The paper's photometric model (a scale only) by default: then the
   // fitted scales must equal the exposure ratios. With the offset the scale
   // is a contrast ratio (the gain splits between c and b), so only depth
@@ -164,9 +165,9 @@ MpgcGridStats RunMpgcGrid(const SyntheticScene& s, int ref, int n,
     st.worst_angle = angles.back();
   }
   std::printf(
-      "MPGC n=%d: %d/%d converged; worst depth err %.5f, normal err median "
-      "%.2f max %.2f deg, worst colour scale err %.4f\n",
-      n, st.converged, st.tested, st.worst_depth, st.median_angle,
+      "MPGC n=%d step %d: %d/%d converged; worst depth err %.5f, normal err "
+      "median %.2f max %.2f deg, worst colour scale err %.4f\n",
+      n, step, st.converged, st.tested, st.worst_depth, st.median_angle,
       st.worst_angle, st.worst_scale);
   return st;
 }
@@ -196,6 +197,28 @@ TEST(MvsMpgc, RecoversSlantedPlaneDepthNormalAndColourScales) {
   EXPECT_GE(o5.converged, o5.tested - 1);
   EXPECT_LT(o5.worst_depth, 0.005);
   EXPECT_LT(o5.median_angle, 12.0);
+  // 5 x 5 samples 2 pixels apart (mpgc.window_step 2, a 9-pixel footprint
+  // at the cost of 5 x 5): the wider footprint constrains the slant as a
+  // wide window does; depth and scales as exact.
+  const MpgcGridStats d5 = RunMpgcGrid(s, ref, 5, false, 2);
+  EXPECT_GE(d5.converged, d5.tested - 1);
+  EXPECT_LT(d5.worst_depth, 0.003);
+  EXPECT_LT(d5.worst_scale, 0.05);
+  EXPECT_LT(d5.median_angle, 5.0);
+  EXPECT_LT(d5.median_angle, s5.median_angle);
+  MpgcOptions bad;
+  bad.window_step = -1;
+  EXPECT_THROW(bad.Check(), std::exception);
+  bad.window_step = 5;
+  EXPECT_THROW(bad.Check(), std::exception);
+  // 0 = by R's working size: the paper's spacing for small images, the
+  // wider footprint from kWideWindowFromPx on the longer side.
+  EXPECT_EQ(AutoWindowStep(0, 640, 480), 1);
+  EXPECT_EQ(AutoWindowStep(0, 1199, 800), 1);
+  EXPECT_EQ(AutoWindowStep(0, 1536, 1024), 2);
+  EXPECT_EQ(AutoWindowStep(0, 1024, 1536), 2);
+  EXPECT_EQ(AutoWindowStep(3, 640, 480), 3);
+  EXPECT_EQ(AutoWindowStep(1, 3072, 2048), 1);
 
   const PatchContext ctx = MakeContext(s, ref);
   // Without normal optimisation the normal stays fronto-parallel.
@@ -435,6 +458,23 @@ TEST(MvsRegionGrowing, StartHypothesesGrowThePlane) {
   const GrowOutcome d = GrowPlaneFromOneSeed(opt, 2);
   EXPECT_EQ(d.filled, 0);
   EXPECT_EQ(d.stats.pixel_visits, 2);
+}
+
+// mvs.growing.expand_min_ncc: a match below the bar is stored but does not
+// queue its neighbours. On the well-textured plane (matches NCC > 0.9) a bar
+// of 0.7 grows as before; a bar no match reaches keeps only the seed.
+TEST(MvsRegionGrowing, ExpandMinNccStopsGrowthFromWeakMatches) {
+  RegionGrowingOptions opt;
+  const GrowOutcome a = GrowPlaneFromOneSeed(opt, 2);
+  opt.expand_min_ncc = 0.7;
+  const GrowOutcome b = GrowPlaneFromOneSeed(opt, 2);
+  EXPECT_GT(b.filled, 0.98 * a.filled);
+  EXPECT_LT(b.median, 0.002);
+  opt.expand_min_ncc = 1;
+  const GrowOutcome c = GrowPlaneFromOneSeed(opt, 2);
+  EXPECT_EQ(c.filled, 1);
+  opt.expand_min_ncc = 1.5;
+  EXPECT_THROW(opt.Check(), std::exception);
 }
 
 }  // namespace

@@ -18,8 +18,23 @@
 
 namespace wild_mvs {
 
+// Working images whose longer side reaches this use window_step 2 when
+// MpgcOptions::window_step is 0 (auto).
+constexpr int kWideWindowFromPx = 1200;
+
+// The window step used for a reference image of width x height: `step` when
+// it is > 0, else 1 or 2 by the longer side (kWideWindowFromPx).
+int AutoWindowStep(int step, int width, int height);
+
 struct MpgcOptions {
-  int window = 5;                  // n of the n x n window (paper: 5)
+  int window = 5;  // n of the n x n window (paper: 5)
+  // (beyond the paper, as OpenMVS samples its windows) Pixels between the
+  // window's samples: the n x n samples cover (n - 1) * step + 1 pixels of
+  // R, a wider footprint at the cost of n x n (paper: 1). 0 = by R's working
+  // size (AutoWindowStep): 1 below kWideWindowFromPx on the longer side, 2
+  // from there (measured, docs/EVALUATION.md: fountain-P11 at 1536 px
+  // covers 3 points more with step 2; 640 px scenes lose 0.02 with it).
+  int window_step = 0;
   int settle_iterations = 5;       // iterations before any test (paper: 5)
   double drop_ncc = 0.4;           // kappa: drop views below (paper: 0.4)
   double convergence_eps = 1e-3;   // eps on every NCC change (paper: 0.001)
@@ -186,6 +201,7 @@ class PatchMatcher {
   MpgcOptions mpgc_;
   LocalViewSelectionOptions local_;
   int n_ = 5, half_ = 2, npix_ = 25, channels_ = 3;
+  int step_ = 1, reach_ = 2;  // sample spacing; half_ * step_ (pixels)
   double max_angle_rad_ = 0;
   // Current pixel and window surface (h along the ray, per-pixel offsets).
   int s_ = 0, t_ = 0;

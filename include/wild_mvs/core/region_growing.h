@@ -53,6 +53,12 @@ struct RegionGrowingOptions {
   // With start_views > 0: no MPGC at all when the best start scores below
   // this (NCC units). -1 = off (always match).
   double start_min_score = -1;
+  // (beyond the paper) A match whose mean NCC is below this is stored but
+  // does not expand: its 4-neighbours are not queued from it. Growth then
+  // cannot percolate through a region that it enters only with barely
+  // passing matches (a one-view occluder filled with the background behind
+  // it, docs/EVALUATION.md). -1 = every match expands (paper).
+  double expand_min_ncc = -1;
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h), e.g. "mvs.growing".
