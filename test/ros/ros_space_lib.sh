@@ -31,26 +31,22 @@ start_master() {
 }
 
 # wait_for_topic TOPIC [SECONDS]: TOPIC is advertised
-wait_for_topic() {
-  local t=${2:-20} i
+wait_for_topic() { wait_until_listed rostopic "$@"; }
+
+# wait_until_listed TOOL NAME [SECONDS=20]: until `TOOL list` (rostopic,
+# rosservice) lists NAME (a node advertises its services after its topics;
+# on a loaded machine the gap can be seconds)
+wait_until_listed() {
+  local t=${3:-20} i
   for i in $(seq $((t * 5))); do
-    rostopic list 2>/dev/null | grep -qx "$1" && return 0
+    "$1" list 2>/dev/null | grep -qx "$2" && return 0
     sleep 0.2
   done
   return 1
 }
 
-# wait_for_service NAME [SECONDS=20]: until rosservice lists NAME (a node
-# advertises its services after its topics; on a loaded machine the gap
-# can be seconds)
-wait_for_service() {
-  local t=${2:-20} i
-  for i in $(seq $((t * 5))); do
-    rosservice list 2>/dev/null | grep -qx "$1" && return 0
-    sleep 0.2
-  done
-  return 1
-}
+# wait_for_service NAME [SECONDS=20]
+wait_for_service() { wait_until_listed rosservice "$@"; }
 
 # stop PID NAME: SIGINT, and the process must end by itself within 10 s
 stop() {

@@ -33,6 +33,15 @@ DepthMap GtMap(const SyntheticScene& s, int v, double scale = 1.0) {
   return m;
 }
 
+// A deep copy (DepthMap's cv::Mat members share their data when copied).
+DepthMap Copy(const DepthMap& m) {
+  DepthMap c = m;
+  c.depth = m.depth.clone();
+  c.normal = m.normal.clone();
+  c.confidence = m.confidence.clone();
+  return c;
+}
+
 const SyntheticScene& Scene8() {
   static const SyntheticScene* s = [] {
     testing::SyntheticSpec spec =
@@ -74,10 +83,7 @@ TEST(GeometricConsistency, KeepsTrueDepthsRemovesCorruptedOnes) {
     bad.at<uint8_t>(y, x) = 1;
   }
   const int valid = r.CountValid();
-  DepthMap r_default = r;
-  r_default.depth = r.depth.clone();
-  r_default.normal = r.normal.clone();
-  r_default.confidence = r.confidence.clone();
+  DepthMap r_default = Copy(r);
   // The exact-pixel filter first (search_px 0, no free-space count).
   GeometricConsistencyOptions o;
   o.search_px = 0;
@@ -238,10 +244,7 @@ TEST(GeometricConsistency, FreeSpaceViolationsOutvoteAStrayConfirmation) {
   for (const DepthMap& m : nbs) ptrs.push_back(&m);
   auto kept = [&](double margin, long* good_kept, long* good, long* bad_kept,
                   long* bad_all) {
-    DepthMap m = r;
-    m.depth = r.depth.clone();
-    m.normal = r.normal.clone();
-    m.confidence = r.confidence.clone();
+    DepthMap m = Copy(r);
     GeometricConsistencyOptions o;
     o.search_px = 1;
     o.free_space_margin = margin;
