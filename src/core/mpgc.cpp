@@ -554,6 +554,7 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   const double mean_ncc = sum / num_active_;
   if (mean_ncc < mpgc_.accept_ncc) return false;
   double pair_ncc = std::numeric_limits<double>::quiet_NaN();
+  bool explained = true;
   if (mpgc_.explain_margin >= 0 && num_active_ >= 2 &&
       mean_ncc < mpgc_.explain_below_ncc) {
     // Not even the best view explains R's window as well as the views
@@ -562,10 +563,12 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
     for (int a = 0; a < num_active_; ++a)
       best = std::max(best, slots_[active_slot_[a]].ncc);
     pair_ncc = MeanPairwiseNcc();
-    if (best < pair_ncc - mpgc_.explain_margin) return false;
+    explained = best >= pair_ncc - mpgc_.explain_margin;
+    if (!explained && !mpgc_.explain_keeps_match) return false;
   }
   if (!out) return true;
   out->pair_ncc = pair_ncc;
+  out->explained = explained;
   out->depth = h_ * ray.z();
   out->normal = mpgc_.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);
   out->confidence = std::clamp((mean_ncc + 1.0) * 0.5, 0.0, 1.0);
@@ -770,6 +773,9 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "below this (> 1 = every match)")
       .Min(-1)
       .Max(1.5);
+  registry->Add(key("explain_keeps_match"), &o->explain_keeps_match,
+                "an unexplained match keeps its depth but region growing "
+                "does not expand from it (false = it fails)");
   registry
       ->Add(key("min_texture_levels"), &o->min_texture_levels,
             "do not match reference windows whose spread is below this many "

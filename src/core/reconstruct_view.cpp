@@ -33,6 +33,8 @@ MvsOptions PaperMvsOptions() {
   MvsOptions o;
   o.mpgc.accept_ncc = -1;
   o.mpgc.explain_margin = -1;
+  o.mpgc.explain_below_ncc = 1.1;
+  o.mpgc.explain_keeps_match = false;
   o.mpgc.min_texture_levels = 0;
   o.mpgc.normal_step_halvings = 0;
   o.mpgc.forecast_iteration = -1;

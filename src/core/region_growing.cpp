@@ -410,7 +410,7 @@ class RegionGrower {
       dmap_[p] = static_cast<float>(r.depth);
       for (int k = 0; k < 3; ++k)
         nmap_[3 * p + k] = static_cast<float>(r.normal[k]);
-      if (conf < expand_conf_) continue;  // stored, not expanded
+      if (conf < expand_conf_ || !r.explained) continue;  // not expanded
       const Eigen::Vector3d X0 =
           cam_.BackprojectCam(Eigen::Vector2d(x + 0.5, y + 0.5), r.depth);
       static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
