@@ -136,7 +136,15 @@ class RegionGrower {
         // Given in NCC units; confidence = (NCC + 1) / 2.
         margin_(static_cast<float>(0.5 * options.revisit_margin)),
         min_score_(mpgc.drop_ncc),
-        expand_conf_(static_cast<float>(0.5 * (options.expand_min_ncc + 1))) {
+        expand_conf_(static_cast<float>(0.5 * (options.expand_min_ncc + 1))),
+        // A held sample's explain verdict is not stored with the map: with
+        // the explain test keeping unexplained matches, only held samples
+        // above its gate (never tested) expand.
+        held_expand_conf_(std::max(
+            expand_conf_,
+            mpgc.explain_margin >= 0 && mpgc.explain_keeps_match
+                ? static_cast<float>(0.5 * (mpgc.explain_below_ncc + 1))
+                : 0.0f)) {
     if (!mask.empty()) mask_ = mask.isContinuous() ? mask : mask.clone();
     mmap_ = mask_.empty() ? nullptr : mask_.ptr<uint8_t>();
     dmap_ = depth->ptr<float>();
@@ -187,6 +195,7 @@ class RegionGrower {
         if (!s.held || s.x < 0 || s.y < 0 || s.x >= W_ || s.y >= H_) continue;
         const int p = s.y * W_ + s.x;
         if (!(cmap_[p] > 0) || !(dmap_[p] > 0)) continue;
+        if (cmap_[p] < held_expand_conf_) continue;
         ++stats_.held_seeds;
         const Eigen::Vector3d n(nmap_[3 * p], nmap_[3 * p + 1],
                                 nmap_[3 * p + 2]);
@@ -462,6 +471,7 @@ class RegionGrower {
   const float margin_;
   const double min_score_;
   const float expand_conf_;  // confidence below which a match does not expand
+  const float held_expand_conf_;  // the same for held samples
   cv::Mat mask_;
   const uint8_t* mmap_ = nullptr;
   float* dmap_ = nullptr;

@@ -127,7 +127,7 @@ MpgcOptions ExplainOn() {
 TEST(OneViewOccluder, MpgcAtTheBackgroundBehindTheBox) {
   const Scenes& s = Get();
   MpgcOptions off;
-  off.explain_margin = 2;  // computes pair_ncc but never fails a match
+  off.explain_margin = 2;       // computes pair_ncc but never fails a match
   off.explain_below_ncc = 1.1;  // for every match
   const Tally box_off = MatchPixels(s, off, true);
   const Tally scene_off = MatchPixels(s, off, false);
@@ -207,11 +207,12 @@ TEST(OneViewOccluder, ReconstructViewLeavesTheBoxEmpty) {
   // 0.95 mostly) grow as before.
   MvsOptions stop = off;
   stop.growing.expand_min_ncc = 0.7;
+  auto print = [](const char* what, const Count& n) {
+    std::printf("%s: %d estimates on the box, %d elsewhere (%d within 1 %%)\n",
+                what, n.box, n.elsewhere, n.within);
+  };
   const Count c = run(stop);
-  std::printf(
-      "expand_min_ncc 0.7: %d estimates on the box, %d elsewhere (%d within "
-      "1 %%)\n",
-      c.box, c.elsewhere, c.within);
+  print("expand_min_ncc 0.7", c);
   // Measured: 187 on the box, 19056 within 1 % elsewhere (-4 % on this
   // end view; -0.001 of completeness over the 12 views of `clutter`).
   EXPECT_LT(c.box, a.box / 4);
@@ -225,10 +226,7 @@ TEST(OneViewOccluder, ReconstructViewLeavesTheBoxEmpty) {
   keep.mpgc.explain_below_ncc = 0.8;
   keep.mpgc.explain_keeps_match = true;
   const Count k = run(keep);
-  std::printf(
-      "explain, keeping the match: %d estimates on the box, %d elsewhere "
-      "(%d within 1 %%)\n",
-      k.box, k.elsewhere, k.within);
+  print("explain, keeping the match", k);
   EXPECT_LT(k.box, a.box / 2);
   EXPECT_GT(k.within, a.within * 0.98);
 }
