@@ -42,6 +42,13 @@ DepthMap Copy(const DepthMap& m) {
   return c;
 }
 
+// The neighbour list FilterByConsistency takes.
+std::vector<const DepthMap*> Pointers(const std::vector<DepthMap>& maps) {
+  std::vector<const DepthMap*> p;
+  for (const DepthMap& m : maps) p.push_back(&m);
+  return p;
+}
+
 const SyntheticScene& Scene8() {
   static const SyntheticScene* s = [] {
     testing::SyntheticSpec spec =
@@ -62,8 +69,7 @@ TEST(GeometricConsistency, KeepsTrueDepthsRemovesCorruptedOnes) {
   DepthMap r = GtMap(s, ref);
   std::vector<DepthMap> nbs;
   for (int v : {1, 2, 4, 5}) nbs.push_back(GtMap(s, v, v == 5 ? 0.5 : 1.0));
-  std::vector<const DepthMap*> ptrs;
-  for (const DepthMap& m : nbs) ptrs.push_back(&m);
+  const std::vector<const DepthMap*> ptrs = Pointers(nbs);
   // Corrupt a block by +3 % and 500 random pixels by -10 .. +10 %.
   cv::Mat bad = cv::Mat::zeros(r.depth.size(), CV_8U);
   for (int y = 40; y < 70; ++y)
@@ -177,8 +183,7 @@ TEST(GeometricConsistency, SearchPxConfirmsAcrossHolesInTheNeighbours) {
       for (int x = (y % 2); x < nbs.back().width(); x += 2)
         nbs.back().depth.at<float>(y, x) = 0;
   }
-  std::vector<const DepthMap*> ptrs;
-  for (const DepthMap& m : nbs) ptrs.push_back(&m);
+  const std::vector<const DepthMap*> ptrs = Pointers(nbs);
   auto kept_fraction = [&](int search_px, float factor) {
     DepthMap r = GtMap(s, ref);
     r.depth *= factor;
@@ -240,8 +245,7 @@ TEST(GeometricConsistency, FreeSpaceViolationsOutvoteAStrayConfirmation) {
       const double t = (z - zr0) / (zr1 - zr0);  // along o + t (c - o)
       accomplice.depth.at<float>(qy, qx) = static_cast<float>(t);
     }
-  std::vector<const DepthMap*> ptrs;
-  for (const DepthMap& m : nbs) ptrs.push_back(&m);
+  const std::vector<const DepthMap*> ptrs = Pointers(nbs);
   auto kept = [&](double margin, long* good_kept, long* good, long* bad_kept,
                   long* bad_all) {
     DepthMap m = Copy(r);
