@@ -71,6 +71,12 @@ void MpgcOptions::Check() const {
           "mvs.mpgc.forecast_iteration = ", forecast_iteration,
           " must be -1 (off) or in [0, mvs.mpgc.settle_iterations = ",
           settle_iterations, ")");
+  Require(std::isfinite(bilateral_sigma_color) && bilateral_sigma_color >= 0,
+          "mvs.mpgc.bilateral_sigma_color = ", bilateral_sigma_color,
+          " must be >= 0 (0 = off)");
+  Require(std::isfinite(bilateral_sigma_space) && bilateral_sigma_space > 0,
+          "mvs.mpgc.bilateral_sigma_space = ", bilateral_sigma_space,
+          " must be > 0");
   Require(std::isfinite(forecast_margin) && forecast_margin >= 0 &&
               forecast_margin <= 2,
           "mvs.mpgc.forecast_margin = ", forecast_margin, " must be in [0, 2]");
@@ -124,6 +130,14 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
     oi_[k] = (p % n_ - half_) * step_;
     oj_[k] = (p / n_ - half_) * step_;
   }
+  for (int k = 0; k < npix_; ++k) {
+    const double di = oi_[k] / step_, dj = oj_[k] / step_;
+    space_weight_[k] =
+        std::exp(-(di * di + dj * dj) / (2 * mpgc_.bilateral_sigma_space *
+                                         mpgc_.bilateral_sigma_space));
+    weight_[k] = 1;
+  }
+  weight_sum_ = npix_;
   for (int k = 0; k < npix_; ++k)
     for (int c = 0; c < 4; ++c) {
       mask_[4 * k + c] = c < channels_ ? 1.0f : 0.0f;
@@ -199,7 +213,7 @@ double PatchMatcher::SlotNcc(int slot_index) const {
   double sbb = 0, sab = 0;
   mpgc_kernels::NccSums(ref_centered_, slots_[slot_index].val, mask_, npix_,
                         &sbb, &sab);
-  const double m = static_cast<double>(npix_) * channels_;
+  const double m = weight_sum_ * channels_;
   if (ref_saa_ < kNccMinVariance * m || sbb < kNccMinVariance * m) return -1;
   return sab / std::sqrt(ref_saa_ * sbb);
 }
@@ -209,20 +223,20 @@ void PatchMatcher::InitScales(int slot_index) {
   for (int c = 0; c < 3; ++c) sl.scale[c] = 1.0f;
   if (!mpgc_.optimize_color_scale) return;
   for (int c = 0; c < channels_; ++c) {
-    double sv = 0, svv = 0;
+    double sv = 0, svv = 0;  // weighted (weight_)
     for (int i = 0; i < npix_; ++i) {
       const double p = sl.val[4 * i + c];
-      sv += p;
-      svv += p * p;
+      sv += weight_[i] * p;
+      svv += weight_[i] * p * p;
     }
     if (mpgc_.photometric_offset) {
       // Contrast ratio of the mean-free windows.
       const double saa = ref_saa_c_[c];
-      const double sbb = svv - sv * sv / npix_;
+      const double sbb = svv - sv * sv / weight_sum_;
       if (sbb > 1e-12 && saa > 1e-12)
         sl.scale[c] = static_cast<float>(std::sqrt(saa / sbb));
-    } else if (sv > 1e-6 && ref_sum_[c] > 1e-6) {
-      sl.scale[c] = static_cast<float>(ref_sum_[c] / sv);
+    } else if (sv > 1e-6 && ref_wmean_[c] > 1e-6) {
+      sl.scale[c] = static_cast<float>(ref_wmean_[c] * weight_sum_ / sv);
     }
   }
 }
@@ -305,16 +319,10 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   for (int c = 0; c < channels_; ++c) {
     const double mean = ref_sum_[c] / npix_;
     double var_c = 0;
-    double saa_c = 0;
     for (int i = 0; i < npix_; ++i) {
       const double d = ref_[4 * i + c] - mean;
-      const float df = static_cast<float>(d);
-      ref_centered_[4 * i + c] = df;
       var_c += d * d;
-      ref_saa_ += static_cast<double>(df) * df;
-      saa_c += static_cast<double>(df) * df;
     }
-    ref_saa_c_[c] = saa_c;
     var_total += var_c;
     if (mpgc_.min_texture_levels > 0)
       levels += std::sqrt(var_c / npix_) * 255.0 / LinearPerSrgb(mean);
@@ -322,6 +330,29 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   // A textureless reference window cannot be matched (NCC undefined).
   if (var_total < kNccMinVariance * npix_ * channels_ * 100) return false;
   if (levels < mpgc_.min_texture_levels * channels_) return false;
+  // The weights depend on R's window only: kept while the pixel is the
+  // same (PlaneScore scores several planes at one pixel).
+  if (mpgc_.bilateral_sigma_color > 0 && (s != weights_s_ || t != weights_t_)) {
+    SetBilateralWeights();
+    weights_s_ = s;
+    weights_t_ = t;
+  }
+  for (int c = 0; c < channels_; ++c) {
+    double sum = 0;
+    for (int i = 0; i < npix_; ++i) sum += weight_[i] * ref_[4 * i + c];
+    const double mean = sum / weight_sum_;
+    ref_wmean_[c] = mean;
+    double saa_c = 0;
+    for (int i = 0; i < npix_; ++i) {
+      const double d = ref_[4 * i + c] - mean;
+      const float df = static_cast<float>(d);
+      const double wdf = weight_[i] * df;
+      ref_centered_[4 * i + c] = static_cast<float>(wdf);
+      saa_c += wdf * df;
+    }
+    ref_saa_c_[c] = saa_c;
+    ref_saa_ += saa_c;
+  }
   Eigen::Vector3d n = normal;
   if (!mpgc_.optimize_normal || !(n.norm() > 0.5))
     n = Eigen::Vector3d(0, 0, -1);
@@ -336,6 +367,30 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   num_active_ = 0;
   for (SlotData& sl : slots_) sl.fresh = false;
   return true;
+}
+
+// Bilateral weights of R's window (MpgcOptions::bilateral_sigma_color):
+// closeness to the centre sample in space and in gamma-2 encoded colour.
+void PatchMatcher::SetBilateralWeights() {
+  const int centre = npix_ / 2;
+  double enc_centre[3];
+  for (int c = 0; c < channels_; ++c)
+    enc_centre[c] = 255.0 * std::sqrt(std::max(0.0f, ref_[4 * centre + c]));
+  const double inv2s2 = 1.0 / (2.0 * mpgc_.bilateral_sigma_color *
+                               mpgc_.bilateral_sigma_color * channels_);
+  weight_sum_ = 0;
+  for (int i = 0; i < npix_; ++i) {
+    double dc2 = 0;
+    for (int c = 0; c < channels_; ++c) {
+      const double e =
+          255.0 * std::sqrt(std::max(0.0f, ref_[4 * i + c])) - enc_centre[c];
+      dc2 += e * e;
+    }
+    weight_[i] = space_weight_[i] * std::exp(-dc2 * inv2s2);
+    weight_sum_ += weight_[i];
+    const float r = static_cast<float>(std::sqrt(weight_[i]));
+    for (int c = 0; c < channels_; ++c) mask_[4 * i + c] = r;
+  }
 }
 
 double PatchMatcher::PlaneScore(int s, int t, double depth,
@@ -594,16 +649,16 @@ double PatchMatcher::MeanPairwiseNcc() const {
     ss[a] = 0;
     for (int ch = 0; ch < channels_; ++ch) {
       double m = 0;
-      for (int i = 0; i < npix_; ++i) m += v[4 * i + ch];
-      m /= npix_;
+      for (int i = 0; i < npix_; ++i) m += weight_[i] * v[4 * i + ch];
+      m /= weight_sum_;
       for (int i = 0; i < npix_; ++i) {
         const float d = static_cast<float>(v[4 * i + ch] - m);
         c[a][4 * i + ch] = d;
-        ss[a] += static_cast<double>(d) * d;
+        ss[a] += weight_[i] * d * d;
       }
     }
   }
-  const double floor = kNccMinVariance * npix_ * channels_;
+  const double floor = kNccMinVariance * weight_sum_ * channels_;
   double sum = 0;
   int pairs = 0;
   for (int a = 0; a < num_active_; ++a)
@@ -611,7 +666,7 @@ double PatchMatcher::MeanPairwiseNcc() const {
       double sab = 0;
       for (int ch = 0; ch < channels_; ++ch)
         for (int i = 0; i < npix_; ++i)
-          sab += static_cast<double>(c[a][4 * i + ch]) * c[b][4 * i + ch];
+          sab += weight_[i] * c[a][4 * i + ch] * c[b][4 * i + ch];
       sum += (ss[a] < floor || ss[b] < floor) ? -1
                                               : sab / std::sqrt(ss[a] * ss[b]);
       ++pairs;
@@ -782,6 +837,16 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "8-bit sRGB levels; 0 = off (paper)")
       .Min(0)
       .Max(64);
+  registry
+      ->Add(key("bilateral_sigma_color"), &o->bilateral_sigma_color,
+            "weight window samples by their colour difference from the "
+            "centre (sigma in 8-bit gamma-2 levels) and distance; 0 = off "
+            "(paper)")
+      .Min(0);
+  registry
+      ->Add(key("bilateral_sigma_space"), &o->bilateral_sigma_space,
+            "spatial sigma of the bilateral weights, in window samples")
+      .Above(0);
   registry
       ->Add(key("normal_step_halvings"), &o->normal_step_halvings,
             "halve a normal step that turns the patch away up to this many "

@@ -65,10 +65,15 @@ bool SampleWindowImpl(const SampleArgs& s, float* HWY_RESTRICT val,
 void NccSumsImpl(const float* HWY_RESTRICT ref_c, const float* HWY_RESTRICT val,
                  const float* HWY_RESTRICT mask, int npix, double* sbb,
                  double* sab) {
-  float sum[4] = {0, 0, 0, 0};
-  for (int k = 0; k < 4 * npix; ++k) sum[k & 3] += val[k];
+  float sum[4] = {0, 0, 0, 0}, wsum[4] = {0, 0, 0, 0};
+  for (int k = 0; k < 4 * npix; ++k) {
+    const float w = mask[k] * mask[k];
+    sum[k & 3] += w * val[k];
+    wsum[k & 3] += w;
+  }
   float mean[4];
-  for (int c = 0; c < 4; ++c) mean[c] = static_cast<float>(sum[c] / npix);
+  for (int c = 0; c < 4; ++c)
+    mean[c] = wsum[c] > 0 ? static_cast<float>(sum[c] / wsum[c]) : 0.0f;
   float bb = 0, ab = 0;
   for (int k = 0; k < 4 * npix; ++k) {
     const float d = (val[k] - mean[k & 3]) * mask[k];
@@ -89,17 +94,21 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
   const float sc[4] = {scale[0], scale[1], scale[2], 0.0f};
   float m[5][4] = {};
   if (center) {
+    float wsum[4] = {0, 0, 0, 0};
     for (int k = 0; k < 4 * npix; ++k) {
       const int c = k & 3;
+      const float w = mask[k] * mask[k];
       const float q = sc[c] * dval[k];
-      m[0][c] += q;
-      m[1][c] += q * wi[k];
-      m[2][c] += q * wj[k];
-      m[3][c] += val[k];
-      m[4][c] += ref[k] - sc[c] * val[k];
+      m[0][c] += w * q;
+      m[1][c] += w * (q * wi[k]);
+      m[2][c] += w * (q * wj[k]);
+      m[3][c] += w * val[k];
+      m[4][c] += w * (ref[k] - sc[c] * val[k]);
+      wsum[c] += w;
     }
     for (auto& mk : m)
-      for (float& v : mk) v = static_cast<float>(v / npix);
+      for (int c = 0; c < 4; ++c)
+        mk[c] = wsum[c] > 0 ? static_cast<float>(mk[c] / wsum[c]) : 0.0f;
   }
   float f[14][4] = {};
   for (int k = 0; k < 4 * npix; ++k) {
@@ -164,6 +173,15 @@ HWY_INLINE double SumLanes(D d, V v) {
   double c[4];
   FoldChannels(d, v, c);
   return c[0] + c[1] + c[2] + c[3];
+}
+
+// m[c] /= the channel's total weight (lane sums of w folded; 0 where a
+// channel has no weight, e.g. the unused fourth lane).
+template <class D, class V>
+HWY_INLINE void DivideByWeights(D d, V w, double m[4]) {
+  double ws[4];
+  FoldChannels(d, w, ws);
+  for (int c = 0; c < 4; ++c) m[c] = ws[c] > 0 ? m[c] / ws[c] : 0.0;
 }
 
 // Four per-channel values repeated over every 128-bit block of a vector.
@@ -328,11 +346,16 @@ void NccSumsImpl(const float* HWY_RESTRICT ref_c, const float* HWY_RESTRICT val,
   const int n = static_cast<int>(hn::Lanes(d));
   const int nf = Floats(d, npix);
   // Two passes (mean, then centred sums): float keeps its precision.
-  auto sum = hn::Zero(d);
-  for (int k = 0; k < nf; k += n) sum = hn::Add(sum, hn::Load(d, val + k));
+  auto sum = hn::Zero(d), wsum = sum;
+  for (int k = 0; k < nf; k += n) {
+    const auto r = hn::Load(d, mask + k);
+    const auto w = hn::Mul(r, r);
+    sum = hn::MulAdd(w, hn::Load(d, val + k), sum);
+    wsum = hn::Add(wsum, w);
+  }
   double mean[4];
   FoldChannels(d, sum, mean);
-  for (double& m : mean) m /= npix;
+  DivideByWeights(d, wsum, mean);
   const auto mv = Channels(d, mean);
   auto bb = hn::Zero(d), ab = hn::Zero(d);
   for (int k = 0; k < nf; k += n) {
@@ -360,37 +383,41 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
   // Pass 1: the window means of q, q i, q j, I and e per channel.
   double m[5][4] = {};
   if (center && depth_only) {
-    auto sq = hn::Zero(d), se = sq;
+    auto sq = hn::Zero(d), se = sq, sw = sq;
     for (int k = 0; k < nf; k += n) {
+      const auto r = hn::Load(d, mask + k);
+      const auto w = hn::Mul(r, r);
       const auto I = hn::Load(d, val + k);
-      sq = hn::MulAdd(sc, hn::Load(d, dval + k), sq);
-      se = hn::Add(se, hn::Sub(hn::Load(d, ref + k), hn::Mul(sc, I)));
+      const auto q = hn::Mul(sc, hn::Load(d, dval + k));
+      sq = hn::MulAdd(w, q, sq);
+      se = hn::MulAdd(w, hn::Sub(hn::Load(d, ref + k), hn::Mul(sc, I)), se);
+      sw = hn::Add(sw, w);
     }
     FoldChannels(d, sq, m[0]);
     FoldChannels(d, se, m[4]);
-    for (int c = 0; c < 4; ++c) {
-      m[0][c] /= npix;
-      m[4][c] /= npix;
-    }
+    DivideByWeights(d, sw, m[0]);
+    DivideByWeights(d, sw, m[4]);
   } else if (center) {
-    auto sq = hn::Zero(d), sqi = sq, sqj = sq, si = sq, se = sq;
+    auto sq = hn::Zero(d), sqi = sq, sqj = sq, si = sq, se = sq, sw = sq;
     for (int k = 0; k < nf; k += n) {
+      const auto r = hn::Load(d, mask + k);
+      const auto w = hn::Mul(r, r);
       const auto I = hn::Load(d, val + k);
       const auto q = hn::Mul(sc, hn::Load(d, dval + k));
       const auto e = hn::Sub(hn::Load(d, ref + k), hn::Mul(sc, I));
-      sq = hn::Add(sq, q);
-      sqi = hn::MulAdd(q, hn::Load(d, wi + k), sqi);
-      sqj = hn::MulAdd(q, hn::Load(d, wj + k), sqj);
-      si = hn::Add(si, I);
-      se = hn::Add(se, e);
+      sq = hn::MulAdd(w, q, sq);
+      sqi = hn::MulAdd(w, hn::Mul(q, hn::Load(d, wi + k)), sqi);
+      sqj = hn::MulAdd(w, hn::Mul(q, hn::Load(d, wj + k)), sqj);
+      si = hn::MulAdd(w, I, si);
+      se = hn::MulAdd(w, e, se);
+      sw = hn::Add(sw, w);
     }
     FoldChannels(d, sq, m[0]);
     FoldChannels(d, sqi, m[1]);
     FoldChannels(d, sqj, m[2]);
     FoldChannels(d, si, m[3]);
     FoldChannels(d, se, m[4]);
-    for (auto& mk : m)
-      for (double& v : mk) v /= npix;
+    for (auto& mk : m) DivideByWeights(d, sw, mk);
   }
   const auto mq = Channels(d, m[0]), mqi = Channels(d, m[1]),
              mqj = Channels(d, m[2]), mi = Channels(d, m[3]),

@@ -39,6 +39,9 @@ MvsOptions PaperMvsOptions() {
   o.mpgc.normal_step_halvings = 0;
   o.mpgc.forecast_iteration = -1;
   o.mpgc.photometric_offset = false;
+  o.mpgc.bilateral_sigma_color = 0;
+  o.mpgc.drop_ncc = 0.4;
+  o.local.min_ncc = 0.3;
   o.mpgc.window = 5;
   o.mpgc.window_step = 1;
   o.growing.revisit_margin = 0;

@@ -65,7 +65,11 @@ struct KernelCase {
   int n = 5, npix = 25;
   mk::SampleArgs args;
 
-  KernelCase(std::mt19937* rng, int window, int ch) : channels(ch) {
+  // weighted: the lanes of `mask` hold random root weights in [0.2, 1] per
+  // pixel (the bilateral window, MpgcOptions::bilateral_sigma_color), and
+  // ref_c is R's weighted deviation from its weighted mean, times w.
+  KernelCase(std::mt19937* rng, int window, int ch, bool weighted = false)
+      : channels(ch) {
     std::uniform_real_distribution<float> u(0.f, 1.f);
     image.resize(static_cast<size_t>(width) * height * channels);
     for (float& v : image) v = u(*rng);
@@ -91,20 +95,27 @@ struct KernelCase {
       rays.ay[k] = y0 + 0.9 * j + ty * i;
       rays.az[k] = 1.0 + 0.001 * (i + j);
     }
-    double mean[3] = {0, 0, 0};
-    for (int k = 0; k < npix; ++k)
+    double mean[3] = {0, 0, 0}, wsum = 0;
+    for (int k = 0; k < npix; ++k) {
+      const float r = weighted ? 0.2f + 0.8f * u(*rng) : 1.f;
+      const double w = static_cast<double>(r) * r;
+      wsum += w;
       for (int c = 0; c < 4; ++c) {
-        mask[4 * k + c] = c < channels ? 1.f : 0.f;
+        mask[4 * k + c] = c < channels ? r : 0.f;
         wi[4 * k + c] = static_cast<float>(oi[k]);
         wj[4 * k + c] = static_cast<float>(oj[k]);
         if (c < channels) {
           ref[4 * k + c] = u(*rng);
-          mean[c] += ref[4 * k + c] / npix;
+          mean[c] += w * ref[4 * k + c];
         }
       }
+    }
+    for (double& m : mean) m /= wsum;
     for (int k = 0; k < npix; ++k)
       for (int c = 0; c < channels; ++c)
-        ref_c[4 * k + c] = static_cast<float>(ref[4 * k + c] - mean[c]);
+        ref_c[4 * k + c] =
+            static_cast<float>(static_cast<double>(mask[4 * k + c]) *
+                               mask[4 * k + c] * (ref[4 * k + c] - mean[c]));
     args.data = image.data();
     args.width = width;
     args.height = height;
@@ -152,7 +163,7 @@ TEST(MpgcKernels, VectorTargetsMatchScalar) {
   for (int trial = 0; trial < 300; ++trial) {
     const int window = 3 + 2 * (trial % 4);  // 3, 5, 7, 9
     const int channels = trial % 5 == 0 ? 1 : 3;
-    KernelCase kc(&rng, window, channels);
+    KernelCase kc(&rng, window, channels, /*weighted=*/trial % 3 == 1);
     if (trial % 10 == 9) kc.args.b[0] = 500;  // off the image: must fail
     const bool center = trial % 2 == 0;
     KernelOut ref;
@@ -206,6 +217,58 @@ TEST(MpgcKernels, VectorTargetsMatchScalar) {
               compared, outside, targets.size());
   EXPECT_GT(compared, 100);
   EXPECT_GT(outside, 0);
+}
+
+// With weights (mask = root weights r, w = r^2) the kernels' sums are the
+// w-weighted sums about the w-weighted means, computed here directly in
+// double precision on the kernels' own samples; with every weight 1 they
+// are the plain window's.
+TEST(MpgcKernels, WeightedSumsAreTheWeightedDefinitions) {
+  std::mt19937 rng(11);
+  int compared = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int channels = trial % 4 == 0 ? 1 : 3;
+    const KernelCase kc(&rng, 5, channels, /*weighted=*/trial % 2 == 0);
+    const KernelOut o = RunKernels(kc, /*center=*/true);
+    if (!o.inside) continue;
+    ++compared;
+    const float scale[3] = {1.1f, 0.9f, 1.0f};
+    double sbb = 0, sab = 0;
+    for (int c = 0; c < channels; ++c) {
+      double sw = 0, mv = 0, mq = 0, me = 0;
+      for (int k = 0; k < kc.npix; ++k) {
+        const double w =
+            static_cast<double>(kc.mask[4 * k + c]) * kc.mask[4 * k + c];
+        const double v = o.val[4 * k + c];
+        sw += w;
+        mv += w * v;
+        mq += w * scale[c] * o.dval[4 * k + c];
+        me += w * (kc.ref[4 * k + c] - scale[c] * v);
+      }
+      mv /= sw;
+      mq /= sw;
+      me /= sw;
+      double h0 = 0, g0 = 0;
+      for (int k = 0; k < kc.npix; ++k) {
+        const double w =
+            static_cast<double>(kc.mask[4 * k + c]) * kc.mask[4 * k + c];
+        const double v = o.val[4 * k + c];
+        const double q = scale[c] * o.dval[4 * k + c] - mq;
+        const double e = kc.ref[4 * k + c] - scale[c] * v - me;
+        sbb += w * (v - mv) * (v - mv);
+        sab += kc.ref_c[4 * k + c] * v;
+        h0 += w * q * q;
+        g0 += w * q * e;
+      }
+      EXPECT_LT(RelDiff(o.full[c].h[0], h0), 1e-4) << trial << " " << c;
+      EXPECT_NEAR(o.full[c].g[0], g0, 1e-4 * (std::abs(g0) + std::sqrt(h0)));
+      EXPECT_LT(RelDiff(o.depth[c].h[0], h0), 1e-4);
+    }
+    EXPECT_LT(RelDiff(o.sbb, sbb), 1e-4) << trial;
+    EXPECT_NEAR(o.sab, sab, 1e-4 * (std::abs(sab) + 1e-3)) << trial;
+  }
+  std::printf("compared %d windows on %s\n", compared, mk::KernelTarget());
+  EXPECT_GT(compared, 30);
 }
 
 // WILD_MVS_SIMD_TARGET (mpgc_kernels::LimitTarget): capping at each target

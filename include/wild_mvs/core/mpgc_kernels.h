@@ -57,9 +57,14 @@ struct SampleArgs {
 // outside the sampling range or behind the camera (outputs then undefined).
 bool SampleWindow(const SampleArgs& args, float* val, float* dval);
 
-// NCC sums of a window against R's centred window ref_c (same layout):
-// *sbb = sum over channels of the centred sum of squares of val, *sab =
-// sum of ref_c * val. mask: 1 on the lanes of real pixels and channels.
+// Weights: `mask` holds the square root r of each lane's weight w = r^2
+// (1 on the lanes of real pixels and channels for the plain window, the
+// bilateral weights of R's window otherwise, 0 on unused lanes); every mean
+// below is the w-weighted mean and every sum of products is w-weighted.
+//
+// NCC sums of a window against R's centred window ref_c (same layout, R's
+// weighted deviations from its weighted mean, times w): *sbb = sum over
+// channels of w (val - mean_w)^2, *sab = sum of ref_c * val.
 void NccSums(const float* ref_c, const float* val, const float* mask, int npix,
              double* sbb, double* sab);
 
@@ -69,7 +74,8 @@ void NccSums(const float* ref_c, const float* val, const float* mask, int npix,
 //   h = sum u u^T (upper triangle: 00 01 02 11 12 22), g = sum u e,
 //   ic = sum u val, ii = sum val^2, ie = sum val e;
 // with `center` every term is taken about its window mean (the photometric
-// offset eliminated at its optimum). depth_only: only h[0] and g[0].
+// offset eliminated at its optimum); every sum weighted by w = mask^2.
+// depth_only: only h[0] and g[0].
 struct ChannelSums {
   double h[6], g[3], ic[3], ii, ie;
 };
