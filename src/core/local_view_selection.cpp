@@ -17,6 +17,9 @@ void LocalViewSelectionOptions::Check() const {
           " must be in (0, 90]");
   Require(min_ncc >= -1 && min_ncc <= 1, "mvs.local.min_ncc = ", min_ncc,
           " must be in [-1, 1]");
+  Require(wide_min_ncc >= -2 && wide_min_ncc <= 1,
+          "mvs.local.wide_min_ncc = ", wide_min_ncc,
+          " must be in [-2, 1] (< -1 = min_ncc)");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -42,6 +45,12 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("min_ncc"), &o->min_ncc,
             "NCC needed to enter the active set (paper: 0.3)")
       .Min(-1)
+      .Max(1);
+  registry
+      ->Add(key("wide_min_ncc"), &o->wide_min_ncc,
+            "min_ncc where the window is wide (window step >= 2); < -1 = "
+            "min_ncc")
+      .Min(-2)
       .Max(1);
 }
 

@@ -29,6 +29,13 @@ int AutoWindowStep(int step, int width, int height) {
   return std::max(width, height) >= kWideWindowFromPx ? 2 : 1;
 }
 
+void UseWideThresholds(int width, int height, MpgcOptions* mpgc,
+                       LocalViewSelectionOptions* local) {
+  if (AutoWindowStep(mpgc->window_step, width, height) < 2) return;
+  if (mpgc->wide_drop_ncc >= -1) mpgc->drop_ncc = mpgc->wide_drop_ncc;
+  if (local->wide_min_ncc >= -1) local->min_ncc = local->wide_min_ncc;
+}
+
 void MpgcOptions::Check() const {
   Require(window >= 3 && window <= kMaxWindow && window % 2 == 1,
           "mvs.mpgc.window = ", window, " must be odd and in [3, ", kMaxWindow,
@@ -40,6 +47,9 @@ void MpgcOptions::Check() const {
           "mvs.mpgc.settle_iterations = ", settle_iterations, " must be >= 0");
   Require(drop_ncc >= -1 && drop_ncc <= 1, "mvs.mpgc.drop_ncc = ", drop_ncc,
           " must be in [-1, 1]");
+  Require(wide_drop_ncc >= -2 && wide_drop_ncc <= 1,
+          "mvs.mpgc.wide_drop_ncc = ", wide_drop_ncc,
+          " must be in [-2, 1] (< -1 = drop_ncc)");
   Require(convergence_eps > 0, "mvs.mpgc.convergence_eps = ", convergence_eps,
           " must be > 0");
   Require(max_iterations > settle_iterations,
@@ -779,6 +789,12 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("drop_ncc"), &o->drop_ncc,
             "drop active views whose NCC falls below (paper: 0.4)")
       .Min(-1)
+      .Max(1);
+  registry
+      ->Add(key("wide_drop_ncc"), &o->wide_drop_ncc,
+            "drop_ncc where the window is wide (window step >= 2); < -1 = "
+            "drop_ncc")
+      .Min(-2)
       .Max(1);
   registry
       ->Add(key("convergence_eps"), &o->convergence_eps,

@@ -40,8 +40,8 @@ MvsOptions PaperMvsOptions() {
   o.mpgc.forecast_iteration = -1;
   o.mpgc.photometric_offset = false;
   o.mpgc.bilateral_sigma_color = 0;
-  o.mpgc.drop_ncc = 0.4;
-  o.local.min_ncc = 0.3;
+  o.mpgc.wide_drop_ncc = -2;
+  o.local.wide_min_ncc = -2;
   o.mpgc.window = 5;
   o.mpgc.window_step = 1;
   o.growing.revisit_margin = 0;
@@ -224,11 +224,14 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
           for (int p : ppv[v]) add_point(p);
     }
 
+    // The matching thresholds for this working size (wide windows).
+    MpgcOptions mpgc = options.mpgc;
+    LocalViewSelectionOptions local = options.local;
+    UseWideThresholds(cam.width, cam.height, &mpgc, &local);
     GrowStats stats;
     if (!seeds.empty())
-      GrowRegions(ctx, options.mpgc, options.local, options.growing, seeds,
-                  wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats,
-                  cancel);
+      GrowRegions(ctx, mpgc, local, options.growing, seeds, wmask, pool,
+                  &dm.depth, &dm.normal, &dm.confidence, &stats, cancel);
     if (!start && (stats.seeds_accepted == 0 ||
                    stats.seeds_accepted < options.sweep.below_seeds)) {
       // No (or too few) sparse features produced a match: seed the pixels
@@ -244,8 +247,8 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
       cv::Mat empty = dm.depth <= 0;  // CV_8U, 255 where nothing grew
       if (!wmask.empty()) empty &= wmask;
       if (scene_depth > 0 && !(cancel && cancel->load()))
-        swept = SweepSeeds(ctx, options.mpgc, options.local, options.sweep, lo,
-                           hi, empty, pool, &body_cpu);
+        swept = SweepSeeds(ctx, mpgc, local, options.sweep, lo, hi, empty, pool,
+                           &body_cpu);
       const std::string why =
           seeds.empty()               ? "no sparse feature projects into it"
           : stats.seeds_accepted == 0 ? "no sparse feature could be matched"
@@ -257,9 +260,8 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
               "; seeded from a fronto-parallel depth sweep over [", lo, ", ",
               hi, "]: ", swept.size(), " seeds"));
       if (!swept.empty())
-        GrowRegions(ctx, options.mpgc, options.local, options.growing, swept,
-                    wmask, pool, &dm.depth, &dm.normal, &dm.confidence, &stats,
-                    cancel);
+        GrowRegions(ctx, mpgc, local, options.growing, swept, wmask, pool,
+                    &dm.depth, &dm.normal, &dm.confidence, &stats, cancel);
     }
     rep.seeds_tried = stats.seeds_tried;
     rep.seeds_accepted = stats.seeds_accepted;

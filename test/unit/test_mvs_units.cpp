@@ -238,6 +238,31 @@ TEST(MvsMpgc, RecoversSlantedPlaneDepthNormalAndColourScales) {
   EXPECT_EQ(AutoWindowStep(0, 1024, 1536), 2);
   EXPECT_EQ(AutoWindowStep(3, 640, 480), 3);
   EXPECT_EQ(AutoWindowStep(1, 3072, 2048), 1);
+  // Wide windows take the wide thresholds; an explicit step 1 or < -1
+  // keeps the plain ones.
+  {
+    MpgcOptions m;
+    LocalViewSelectionOptions l;
+    UseWideThresholds(640, 480, &m, &l);
+    EXPECT_EQ(m.drop_ncc, MpgcOptions().drop_ncc);
+    EXPECT_EQ(l.min_ncc, LocalViewSelectionOptions().min_ncc);
+    UseWideThresholds(1536, 1024, &m, &l);
+    EXPECT_EQ(m.drop_ncc, m.wide_drop_ncc);
+    EXPECT_EQ(l.min_ncc, l.wide_min_ncc);
+    EXPECT_NE(m.wide_drop_ncc, MpgcOptions().drop_ncc);
+    MpgcOptions one;
+    one.window_step = 1;
+    LocalViewSelectionOptions l1;
+    UseWideThresholds(1536, 1024, &one, &l1);
+    EXPECT_EQ(one.drop_ncc, MpgcOptions().drop_ncc);
+    MpgcOptions off;
+    off.wide_drop_ncc = -2;
+    LocalViewSelectionOptions loff;
+    loff.wide_min_ncc = -2;
+    UseWideThresholds(1536, 1024, &off, &loff);
+    EXPECT_EQ(off.drop_ncc, MpgcOptions().drop_ncc);
+    EXPECT_EQ(loff.min_ncc, LocalViewSelectionOptions().min_ncc);
+  }
 
   const PatchContext ctx = MakeContext(s, ref);
   // Without normal optimisation the normal stays fronto-parallel.
@@ -336,14 +361,15 @@ TEST(MvsMpgc, BilateralWindowKeepsDepthEdgesSharp) {
   EXPECT_GT(plain.wrong, plain.tested / 10);
   EXPECT_LT(2 * bilateral.wrong, plain.wrong);
   EXPECT_GE(bilateral.right, plain.right);
-  // The defaults (bilateral 12 / 6 with kappa 0.22) against the plain
-  // window at the same kappa: fewer wrong, more right (measured: 111 -> 90
-  // wrong, 169 -> 197 right; the lower kappa lets more of both pass).
+  // The defaults for wide windows (bilateral 12 / 6 with kappa 0.22)
+  // against the plain window at the same kappa: fewer wrong, more right
+  // (measured: 111 -> 90 wrong, 169 -> 197 right; the lower kappa lets
+  // more of both pass).
   const MpgcOptions defaults;
-  const EdgeStats plain_low = RunDepthEdge(s, 0, 2, defaults.drop_ncc);
+  const EdgeStats plain_low = RunDepthEdge(s, 0, 2, defaults.wide_drop_ncc);
   const EdgeStats now =
       RunDepthEdge(s, defaults.bilateral_sigma_color,
-                   defaults.bilateral_sigma_space, defaults.drop_ncc);
+                   defaults.bilateral_sigma_space, defaults.wide_drop_ncc);
   EXPECT_LT(now.wrong, plain_low.wrong - plain_low.wrong / 10);
   EXPECT_GT(now.right, plain_low.right);
   // Options: a colour sigma < 0 or a spatial sigma <= 0 is refused.

@@ -16,9 +16,10 @@ struct LocalViewSelectionOptions {
   bool enabled = true;
   int num_active = 4;                  // m = |A| (paper: 4)
   double max_epipolar_angle_deg = 10;  // g_max (paper: 10)
-  // NCC to enter A (paper: 0.3; 0.12 with the bilateral window, measured
-  // together with MpgcOptions::drop_ncc, docs/EVALUATION.md).
-  double min_ncc = 0.12;
+  double min_ncc = 0.3;                // NCC to enter A (paper: 0.3)
+  // min_ncc where the window is wide (MpgcOptions::wide_drop_ncc, measured
+  // with it); < -1 = min_ncc.
+  double wide_min_ncc = 0.12;
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h), e.g. "mvs.local".

@@ -36,12 +36,17 @@ struct MpgcOptions {
   // covers 3 points more with step 2; 640 px scenes lose 0.02 with it).
   int window_step = 0;
   int settle_iterations = 5;  // iterations before any test (paper: 5)
-  // kappa: drop views below (paper: 0.4). 0.22 spends the accuracy the
-  // bilateral window gains on coverage (measured, docs/EVALUATION.md,
-  // "Bilateral window": fountain-P11 with colour sigma 10 at kappa 0.4,
-  // 0.3, 0.25, 0.2: 88.3, 89.6, 89.8, 90.0 % coverage at 97.7 to 97.3 %
-  // within 1 %; these defaults: 90.1 % at 97.2 %).
-  double drop_ncc = 0.22;
+  double drop_ncc = 0.4;      // kappa: drop views below (paper: 0.4)
+  // (beyond the paper) kappa where the window is wide (window step >= 2:
+  // AutoWindowStep's choice from kWideWindowFromPx, or an explicit step);
+  // < -1 = drop_ncc. With the bilateral window a lower kappa spends its
+  // accuracy on coverage there (measured, docs/EVALUATION.md, "Bilateral
+  // window": fountain-P11 at 1536 px, colour sigma 10, kappa 0.4 / 0.3 /
+  // 0.25 / 0.2: 88.3 / 89.6 / 89.8 / 90.0 % coverage at 97.7 to 97.3 %
+  // within 1 %; 0.22 with the defaults: 90.1 % at 97.2 %), while at 640 px
+  // it costs speed and gross errors (templeSparseRing -17 % correct per
+  // CPU-s, the rendered clutter scene 1.05 % off by more than 5 %).
+  double wide_drop_ncc = 0.22;
   double convergence_eps = 1e-3;   // eps on every NCC change (paper: 0.001)
   int max_iterations = 20;         // fail after (paper: 20)
   int full_update_interval = 5;    // normal + colour scales at every k-th
@@ -122,6 +127,12 @@ struct MpgcOptions {
 // Registers the fields under `prefix` (option_registry.h), e.g. "mvs.mpgc".
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      MpgcOptions* options);
+
+// The thresholds for a reference image of width x height: where its window
+// is wide (AutoWindowStep >= 2) drop_ncc and local.min_ncc become
+// wide_drop_ncc and local.wide_min_ncc (unless those are < -1).
+void UseWideThresholds(int width, int height, MpgcOptions* mpgc,
+                       LocalViewSelectionOptions* local);
 
 // What happened in one Match call, iteration by iteration (tests and
 // debugging; Match records it only when given one). `iteration` counts the
