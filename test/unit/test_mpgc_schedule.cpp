@@ -290,6 +290,9 @@ TEST(MpgcSchedule, ForecastStopsHopelessPixelsEarly) {
   const int ref = 2;
   const PatchContext ctx = MakeContext(s, ref);
   MpgcOptions paper;
+  paper.bilateral_sigma_color = 0;  // the paper's window (with the
+                                    // bilateral one no window here is
+                                    // hopeless at update 1)
   MpgcOptions fc = paper;
   fc.forecast_iteration = 1;  // default margin 0.1 (with margin 0 here 3
                               // of 27 stopped pixels would have matched)
