@@ -340,13 +340,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   // A textureless reference window cannot be matched (NCC undefined).
   if (var_total < kNccMinVariance * npix_ * channels_ * 100) return false;
   if (levels < mpgc_.min_texture_levels * channels_) return false;
-  // The weights depend on R's window only: kept while the pixel is the
-  // same (PlaneScore scores several planes at one pixel).
-  if (mpgc_.bilateral_sigma_color > 0 && (s != weights_s_ || t != weights_t_)) {
-    SetBilateralWeights();
-    weights_s_ = s;
-    weights_t_ = t;
-  }
+  if (mpgc_.bilateral_sigma_color > 0) SetBilateralWeights();
   for (int c = 0; c < channels_; ++c) {
     double sum = 0;
     for (int i = 0; i < npix_; ++i) sum += weight_[i] * ref_[4 * i + c];

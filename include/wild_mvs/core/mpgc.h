@@ -269,7 +269,6 @@ class PatchMatcher {
   double weight_sum_ = 0;
   double ref_wmean_[3];
   double space_weight_[kMaxWindowPixels];
-  int weights_s_ = -1, weights_t_ = -1;  // the pixel weight_ belongs to
   // Candidate state this visit: 0 free, 1 active, 2 rejected.
   uint8_t state_[kMaxNeighbors];
   Eigen::Vector2d epi_dir_[kMaxNeighbors];
