@@ -87,6 +87,10 @@ void MpgcOptions::Check() const {
   Require(std::isfinite(bilateral_sigma_space) && bilateral_sigma_space > 0,
           "mvs.mpgc.bilateral_sigma_space = ", bilateral_sigma_space,
           " must be > 0");
+  Require(std::isfinite(bilateral_min_weight) && bilateral_min_weight >= 0 &&
+              bilateral_min_weight <= 1,
+          "mvs.mpgc.bilateral_min_weight = ", bilateral_min_weight,
+          " must be in [0, 1]");
   Require(std::isfinite(forecast_margin) && forecast_margin >= 0 &&
               forecast_margin <= 2,
           "mvs.mpgc.forecast_margin = ", forecast_margin, " must be in [0, 2]");
@@ -380,18 +384,31 @@ void PatchMatcher::SetBilateralWeights() {
   double enc_centre[3];
   for (int c = 0; c < channels_; ++c)
     enc_centre[c] = 255.0 * std::sqrt(std::max(0.0f, ref_[4 * centre + c]));
-  const double inv2s2 = 1.0 / (2.0 * mpgc_.bilateral_sigma_color *
-                               mpgc_.bilateral_sigma_color * channels_);
-  weight_sum_ = 0;
+  double dc2[kMaxWindowPixels];
+  double space_sum = 0;
   for (int i = 0; i < npix_; ++i) {
-    double dc2 = 0;
+    dc2[i] = 0;
     for (int c = 0; c < channels_; ++c) {
       const double e =
           255.0 * std::sqrt(std::max(0.0f, ref_[4 * i + c])) - enc_centre[c];
-      dc2 += e * e;
+      dc2[i] += e * e;
     }
-    weight_[i] = space_weight_[i] * std::exp(-dc2 * inv2s2);
-    weight_sum_ += weight_[i];
+    space_sum += space_weight_[i];
+  }
+  // The colour sigma widens (x2, at most 3 times) while the window keeps
+  // less than bilateral_min_weight of its plain weight.
+  double sigma = mpgc_.bilateral_sigma_color;
+  for (int widen = 0;; ++widen, sigma *= 2) {
+    const double inv2s2 = 1.0 / (2.0 * sigma * sigma * channels_);
+    weight_sum_ = 0;
+    for (int i = 0; i < npix_; ++i) {
+      weight_[i] = space_weight_[i] * std::exp(-dc2[i] * inv2s2);
+      weight_sum_ += weight_[i];
+    }
+    if (widen == 3 || weight_sum_ >= mpgc_.bilateral_min_weight * space_sum)
+      break;
+  }
+  for (int i = 0; i < npix_; ++i) {
     const float r = static_cast<float>(std::sqrt(weight_[i]));
     for (int c = 0; c < channels_; ++c) mask_[4 * i + c] = r;
   }
@@ -857,6 +874,13 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("bilateral_sigma_space"), &o->bilateral_sigma_space,
             "spatial sigma of the bilateral weights, in window samples")
       .Above(0);
+  registry
+      ->Add(key("bilateral_min_weight"), &o->bilateral_min_weight,
+            "least fraction of the plain window weight the colour weights "
+            "keep (sigma_color doubles, up to 8x, until they do); 0 = fixed "
+            "sigma_color")
+      .Min(0)
+      .Max(1);
   registry
       ->Add(key("normal_step_halvings"), &o->normal_step_halvings,
             "halve a normal step that turns the patch away up to this many "
