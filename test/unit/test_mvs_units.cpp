@@ -334,26 +334,34 @@ EdgeStats RunDepthEdge(const SyntheticScene& s, double sigma_color,
   return st;
 }
 
-TEST(MvsMpgc, BilateralWindowKeepsDepthEdgesSharp) {
+// A textured 6 x 4 wall through the origin (spanned by x and axis_v),
+// seen by 5 cameras on a 20 degree arc 2 away, width x 3/4 width pixels.
+SyntheticSpec WallSpec(const Eigen::Vector3d& axis_v, int texture_seed,
+                       double texture_scale, int width) {
   SyntheticSpec spec;
-  using T = testing::SyntheticObject::Type;
   testing::SyntheticObject wall;
-  wall.type = T::kPlane;
+  wall.type = testing::SyntheticObject::Type::kPlane;
   wall.axis_u = Eigen::Vector3d(1, 0, 0);
-  wall.axis_v = Eigen::Vector3d(0, 0, 1);
+  wall.axis_v = axis_v;
   wall.size = Eigen::Vector3d(3.0, 2.0, 1);
-  wall.texture_seed = 3;
+  wall.texture_seed = texture_seed;
+  wall.texture_scale = texture_scale;
   spec.objects.push_back(wall);
-  testing::SyntheticObject board = wall;  // left half, 0.6 nearer
+  spec.camera_centers = testing::MakeRingCameras(5, 2.0, 0.0, 20.0);
+  spec.width = width;
+  spec.height = width * 3 / 4;
+  spec.focal = width;
+  spec.num_sparse_points = 20;
+  return spec;
+}
+
+TEST(MvsMpgc, BilateralWindowKeepsDepthEdgesSharp) {
+  SyntheticSpec spec = WallSpec(Eigen::Vector3d(0, 0, 1), 3, 0.05, 240);
+  testing::SyntheticObject board = spec.objects[0];  // left half, 0.6 nearer
   board.center = Eigen::Vector3d(-0.75, -0.6, 0);
   board.size = Eigen::Vector3d(0.75, 1.2, 1);
   board.texture_seed = 21;
   spec.objects.push_back(board);
-  spec.camera_centers = testing::MakeRingCameras(5, 2.0, 0.0, 20.0);
-  spec.width = 240;
-  spec.height = 180;
-  spec.focal = 240;
-  spec.num_sparse_points = 20;
   const SyntheticScene s = Render(spec);
   // At the paper's kappa (0.4): the plain window fattens the edge; the
   // bilateral one (sigma 10, fixed) at most half as often, and it finds the
@@ -414,22 +422,8 @@ EdgeStats RunFineTexture(const SyntheticScene& s, const MpgcOptions& mo) {
 }
 
 TEST(MvsMpgc, BilateralMinWeightKeepsFineTexture) {
-  SyntheticSpec spec;
-  using T = testing::SyntheticObject::Type;
-  testing::SyntheticObject wall;
-  wall.type = T::kPlane;
-  wall.axis_u = Eigen::Vector3d(1, 0, 0);
-  wall.axis_v = Eigen::Vector3d(0, 0.8, 0.6);
-  wall.size = Eigen::Vector3d(3.0, 2.0, 1);
-  wall.texture_seed = 5;
-  wall.texture_scale = 0.012;
-  spec.objects.push_back(wall);
-  spec.camera_centers = testing::MakeRingCameras(5, 2.0, 0.0, 20.0);
-  spec.width = 160;
-  spec.height = 120;
-  spec.focal = 160;
-  spec.num_sparse_points = 20;
-  const SyntheticScene s = Render(spec);
+  const SyntheticScene s =
+      Render(WallSpec(Eigen::Vector3d(0, 0.8, 0.6), 5, 0.012, 160));
   MpgcOptions plain;
   plain.bilateral_sigma_color = 0;
   MpgcOptions fixed;
