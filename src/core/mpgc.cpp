@@ -149,6 +149,7 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
     space_weight_[k] =
         std::exp(-(di * di + dj * dj) / (2 * mpgc_.bilateral_sigma_space *
                                          mpgc_.bilateral_sigma_space));
+    space_weight_sum_ += space_weight_[k];
     weight_[k] = 1;
   }
   weight_sum_ = npix_;
@@ -385,7 +386,6 @@ void PatchMatcher::SetBilateralWeights() {
   for (int c = 0; c < channels_; ++c)
     enc_centre[c] = 255.0 * std::sqrt(std::max(0.0f, ref_[4 * centre + c]));
   double dc2[kMaxWindowPixels];
-  double space_sum = 0;
   for (int i = 0; i < npix_; ++i) {
     dc2[i] = 0;
     for (int c = 0; c < channels_; ++c) {
@@ -393,10 +393,11 @@ void PatchMatcher::SetBilateralWeights() {
           255.0 * std::sqrt(std::max(0.0f, ref_[4 * i + c])) - enc_centre[c];
       dc2[i] += e * e;
     }
-    space_sum += space_weight_[i];
   }
-  // The colour sigma widens (x2, at most 3 times) while the window keeps
-  // less than bilateral_min_weight of its plain weight.
+  // The colour sigma widens (x2, at most kMaxWidenings times) while the
+  // window keeps less than bilateral_min_weight of its plain weight.
+  constexpr int kMaxWidenings = 3;  // sigma_color up to 8x
+  const double min_sum = mpgc_.bilateral_min_weight * space_weight_sum_;
   double sigma = mpgc_.bilateral_sigma_color;
   for (int widen = 0;; ++widen, sigma *= 2) {
     const double inv2s2 = 1.0 / (2.0 * sigma * sigma * channels_);
@@ -405,8 +406,7 @@ void PatchMatcher::SetBilateralWeights() {
       weight_[i] = space_weight_[i] * std::exp(-dc2[i] * inv2s2);
       weight_sum_ += weight_[i];
     }
-    if (widen == 3 || weight_sum_ >= mpgc_.bilateral_min_weight * space_sum)
-      break;
+    if (widen == kMaxWidenings || weight_sum_ >= min_sum) break;
   }
   for (int i = 0; i < npix_; ++i) {
     const float r = static_cast<float>(std::sqrt(weight_[i]));

@@ -279,6 +279,7 @@ class PatchMatcher {
   double weight_sum_ = 0;
   double ref_wmean_[3];
   double space_weight_[kMaxWindowPixels];
+  double space_weight_sum_ = 0;  // of space_weight_, fixed per matcher
   // Candidate state this visit: 0 free, 1 active, 2 rejected.
   uint8_t state_[kMaxNeighbors];
   Eigen::Vector2d epi_dir_[kMaxNeighbors];
