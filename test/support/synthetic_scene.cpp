@@ -317,7 +317,7 @@ void IntersectObject(const Prepared& pr, int index, const Eigen::Vector3d& o,
       const Eigen::Vector3d q = o - ob.center;
       const double r = ob.size.x(), hz = ob.size.z();
       double best = hit->z;
-      Eigen::Vector3d normal;
+      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
       const double a = d.x() * d.x() + d.y() * d.y();
       if (a > 1e-30) {  // the side
         const double b = q.x() * d.x() + q.y() * d.y();

@@ -160,7 +160,9 @@ TEST(SyntheticGeometry, ReliefDepthAndNormalsAreTheAnalyticSurface) {
                 p.dot(N) - ReliefHeight(relief, p.dot(U), p.dot(V));
             if (std::abs(p.dot(U)) > 1 || std::abs(p.dot(V)) > 0.7) continue;
             const double sign = f > 0 ? 1 : -1;
-            if (prev_sign != 0) ASSERT_EQ(sign, prev_sign) << r << " " << c;
+            if (prev_sign != 0) {
+              ASSERT_EQ(sign, prev_sign) << r << " " << c;
+            }
             prev_sign = sign;
           }
         }
