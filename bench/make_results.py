@@ -105,7 +105,7 @@ def plot_quality(path, scenes):
     x = range(len(names))
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 3.8))
     w = 0.4
-    a.bar([i - w / 2 for i in x], [100 * s[1] for s in scenes], w, label="coverage")
+    a.bar([i - w / 2 for i in x], [100 * s[1] for s in scenes], w, label="coverage (rendered scenes: within 1 %)")
     a.bar([i + w / 2 for i in x], [100 * s[2] for s in scenes], w, label="estimates within 1 %")
     a.set_ylim(50, 100)
     a.set_ylabel("%")

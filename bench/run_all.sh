@@ -62,7 +62,9 @@ skipped() { [[ ",$SKIP," == *",$1,"* ]]; }
 for tool in /usr/bin/time bc; do
   command -v "$tool" >/dev/null || { echo "run_all.sh: needs $tool (apt-get install time bc)" >&2; exit 1; }
 done
-python3 -c 'import matplotlib' 2>/dev/null ||
+PY=python3
+[ -x /usr/bin/python3 ] && PY=/usr/bin/python3  # Debian's, with python3-matplotlib
+"$PY" -c 'import matplotlib' 2>/dev/null ||
   { echo "run_all.sh: needs matplotlib (apt-get install python3-matplotlib)" >&2; exit 1; }
 DATASETS="${WILD_MVS_DATASETS:-$ROOT/../shared/datasets}"
 if ! skipped fountain && [ ! -d "$DATASETS/strecha_fountain-P11" ]; then
@@ -127,7 +129,7 @@ fi
 if [ -n "${OPENMVS_BIN:-}" ] && [ "$QUICK" = 0 ]; then
   WILD_MVS_BIN="$BUILD_DIR/bin" bash "$ROOT/bench/run_openmvs.sh" --threads "$THREADS" \
     --out "$OUT/openmvs" --cloud
-  python3 - "$OUT/openmvs" "$OUT/peers" <<'PY'
+  "$PY" - "$OUT/openmvs" "$OUT/peers" <<'PY'
 import os, re, sys
 src, dst = sys.argv[1:]
 os.makedirs(dst, exist_ok=True)
@@ -172,5 +174,5 @@ fi
   printf 'families_note\t%s\n' "$FAMILIES_NOTE"
   printf 'scale_args\t%s\n' "$SCALE_ARGS"
 } >"$OUT/meta.tsv"
-python3 "$ROOT/bench/make_results.py" "$OUT" "$ROOT"
+"$PY" "$ROOT/bench/make_results.py" "$OUT" "$ROOT"
 echo "run_all.sh: wrote docs/RESULTS.md, docs/results_*.png and README's results block (raw outputs in $OUT)" >&2
