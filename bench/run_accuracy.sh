@@ -1,4 +1,7 @@
 #!/usr/bin/env bash
+# The benchmark protocol is bench/run_families.sh (docs/METHODS.md: three
+# scene families, tuning and report seeds); this script keeps the older
+# courtyard table with its extra columns (seed 5).
 # Accuracy benchmark (not a test). Renders the evaluation scenes
 # of bench/scenes/make_scene.cpp (constant light, changing light, clutter,
 # scale; exact ground truth, a sky), runs `wild_mvs reconstruct` (depth,

@@ -9,9 +9,8 @@
 #   fountain  bench/run_fountain.sh: fountain-P11 at 1536x1024 against its
 #             ground-truth depth (coverage, within 1 %, off > 5 %,
 #             background) and the fused cloud's F at 1 / 2 / 5 cm;
-#   families  the rendered scene families with exact ground truth
-#             (bench/run_families.sh where it exists, else the courtyard
-#             kinds of bench/run_accuracy.sh);
+#   families  bench/run_families.sh: the rendered scene families with
+#             exact ground truth (relief, weak, courtyard), report seeds;
 #   scale     bench/run_scale.sh: CPU-s per view and peak RSS against the
 #             number of views (100 / 250 / 500).
 # Peers: with OPENMVS_BIN (the folder of OpenMVS's InterfaceCOLMAP and
@@ -22,9 +21,9 @@
 # Usage: bench/run_all.sh [--quick] [--skip LIST] [--threads N] [--out DIR]
 #                         [--skip-build]
 #   --quick      smaller sizes and one run each (temple 320 px, fountain
-#                384 px, 8 rendered views at 320x240, collections of
-#                10 / 20 / 40 views): minutes instead of hours; RESULTS.md
-#                says so at the top
+#                384 px, 8 rendered views at 320x240 with one seed,
+#                collections of 10 / 20 / 40 views): minutes instead of
+#                hours; RESULTS.md says so at the top
 #   --skip LIST  comma-separated sections not to run (speed, fountain,
 #                families, scale); RESULTS.md lists them as not run
 #   --out DIR    raw outputs (default bench/out/all-<UTC time>, ignored by git)
@@ -87,10 +86,10 @@ if [ "$BUILD" = 1 ]; then
 fi
 
 if [ "$QUICK" = 1 ]; then
-  RUNS=1 TEMPLE_SIZE=320 FOUNTAIN_SIZE=384 VIEWS=8 SCENE_SIZE=320x240
+  RUNS=1 TEMPLE_SIZE=320 FOUNTAIN_SIZE=384 VIEWS=8 SCENE_SIZE=320x240 FAMILY_SEEDS=101
   SCALE_SIZES=10,20,40 SCALE_PX=160
 else
-  RUNS=3 TEMPLE_SIZE=0 FOUNTAIN_SIZE=1536 VIEWS=12 SCENE_SIZE=640x480
+  RUNS=3 TEMPLE_SIZE=0 FOUNTAIN_SIZE=1536 VIEWS=12 SCENE_SIZE=640x480 FAMILY_SEEDS=report
   SCALE_SIZES=100,250,500 SCALE_PX=240
 fi
 
@@ -105,11 +104,17 @@ fi
 FAMILIES_NOTE=""
 if ! skipped families; then
   mkdir -p "$OUT/families"
-  if [ -x "$FAMILIES_SCRIPT" ] || [ -f "$FAMILIES_SCRIPT" ]; then
-    q=()
-    [ "$QUICK" = 1 ] && q=(--quick)
-    bash "$FAMILIES_SCRIPT" "${q[@]}" --threads "$THREADS" --out "$OUT/families"
-    FAMILIES_NOTE="\`bench/run_families.sh\`: one table per family."
+  if [ -f "$FAMILIES_SCRIPT" ]; then
+    v=()
+    [ "$QUICK" = 1 ] && v=(--views "$VIEWS")
+    bash "$FAMILIES_SCRIPT" --skip-build --seeds "$FAMILY_SEEDS" --size "${SCENE_SIZE%x*}" \
+      ${v[@]+"${v[@]}"} --threads "$THREADS" --out "$OUT/families_work" --tag default
+    # One table per family (the family column dropped).
+    awk -F'\t' -v dir="$OUT/families" 'NR == 1 { h = $0; sub(/^[^\t]*\t/, "", h); next }
+      { f = dir "/" $1 ".tsv"; if (!(f in seen)) { print h > f; seen[f] = 1 }
+        line = $0; sub(/^[^\t]*\t/, "", line); print line > f }' \
+      "$OUT/families_work/default.tsv"
+    FAMILIES_NOTE="\`bench/run_families.sh --seeds $FAMILY_SEEDS\` (docs/METHODS.md, \"Benchmark protocol\"): one table per family, a row per scene and seed, and a MEAN row (its seed column: the number of scenes); images $SCENE_SIZE$([ "$QUICK" = 1 ] && echo ", $VIEWS views"). Coverage = ground-truth pixels with an estimate; coverage within 1 % = with an estimate within 1 %; sky = estimates where there is no surface; F against the scene's ground-truth surface samples."
   else
     bash "$ROOT/bench/run_accuracy.sh" --skip-build --views "$VIEWS" --size "$SCENE_SIZE" \
       --threads "$THREADS" --out "$OUT/accuracy" --tag courtyard
@@ -163,11 +168,11 @@ fi
     "$(cut -d' ' -f1-3 /proc/loadavg)"
   printf 'threads\t%s\n' "$THREADS"
   if [ "$QUICK" = 1 ]; then
-    printf 'setting\tquick: temple 320 px, 1 run; fountain 384 px; %s rendered views at %s; collections of %s views at %s px\n' \
-      "$VIEWS" "$SCENE_SIZE" "$SCALE_SIZES" "$SCALE_PX"
+    printf 'setting\tquick: temple 320 px, 1 run; fountain 384 px; rendered scenes %s views at %s, seed %s; collections of %s views at %s px\n' \
+      "$VIEWS" "$SCENE_SIZE" "$FAMILY_SEEDS" "$SCALE_SIZES" "$SCALE_PX"
   else
-    printf 'setting\tfull: temple 640 px, median of 3; fountain 1536 px; %s rendered views at %s; collections of %s views at %s px\n' \
-      "$VIEWS" "$SCENE_SIZE" "$SCALE_SIZES" "$SCALE_PX"
+    printf 'setting\tfull: temple 640 px, median of 3; fountain 1536 px; rendered scenes at %s, %s seeds; collections of %s views at %s px\n' \
+      "$SCENE_SIZE" "$FAMILY_SEEDS" "$SCALE_SIZES" "$SCALE_PX"
   fi
   printf 'temple_size\t%s\n' "$([ "$TEMPLE_SIZE" = 0 ] && echo 640 || echo "$TEMPLE_SIZE")"
   printf 'skipped\t%s\n' "$SKIP"

@@ -1,18 +1,27 @@
 // Copyright wild_mvs authors. Writes a rendered evaluation scene with exact
 // ground truth as a dataset folder (not a test): COLMAP text model with
 // sparse points in sparse/, 8-bit sRGB PNGs in images/, ground-truth depth
-// in gt_depth/ (see testing::WriteDataset). Used by bench/run_accuracy.sh.
+// in gt_depth/ (see testing::WriteDataset), and gt_surface.ply: points on
+// every surface some view sees (one per 2 pixels, thinned to 5 mm voxels;
+// one-view occluders excluded), the reference of `wild_mvs eval cloud`. Used by
+// bench/run_families.sh and bench/run_accuracy.sh.
 //
 //   make_scene KIND OUT_DIR [--views N] [--width W] [--height H] [--seed S]
 //              [--points P]
+//
+// --views: 14 for the relief and weak families, 12 for the courtyard.
 //
 // --points P: sparse points sampled on the surfaces with their exact
 // visibility (1500; 0.3 px noise); 0 = none, so that `wild_mvs reconstruct`
 // computes tracks from the images (SIFT under the scene's light changes, as
 // a user's SfM would).
 //
-// KIND (one courtyard: a textured ground, a back wall, boxes, spheres and a
-// pillar under a sky, cameras on a 100-degree arc):
+// KIND relief or weak: the families of families.h, everything drawn from
+// the seed (family_relief.cpp, family_weak.cpp).
+//
+// Other KINDs (one courtyard: a textured ground, a back wall, boxes, spheres
+// and a pillar under a sky, cameras on a 100-degree arc; the seed draws the
+// light of `light` and the occluders of `clutter`):
 //   constant  the same exposure, white balance and light in every view;
 //   light     per view exposure 0.35..2.6, white balance +-30 %, gamma
 //             1..2.2, vignetting up to 0.5 and a sun from another side
@@ -29,8 +38,11 @@
 #include <string>
 
 #include "courtyard.h"
+#include "families.h"
 #include "synthetic_scene.h"
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/metrics.h"
+#include "wild_mvs/io/ply.h"
 
 using namespace wild_mvs;
 using courtyard::Box;
@@ -122,13 +134,15 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
 int main(int argc, char** argv) {
   if (argc < 3) {
     std::cerr
-        << "usage: make_scene constant|light|exposure|gamma|vignetting|"
-           "sun|clutter|scale OUT_DIR "
+        << "usage: make_scene relief|weak|constant|light|exposure|gamma|"
+           "vignetting|sun|clutter|scale OUT_DIR "
            "[--views N] [--width W] [--height H] [--seed S] [--points P]\n";
     return 2;
   }
   try {
-    int n = 12, w = 640, h = 480, points = 1500;
+    const std::string kind = argv[1];
+    const bool family = kind == "relief" || kind == "weak";
+    int n = family ? 14 : 12, w = 640, h = 480, points = 1500;
     unsigned seed = 5;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
@@ -149,9 +163,22 @@ int main(int argc, char** argv) {
       }
     }
     Require(n >= 3, "make_scene: --views must be >= 3");
-    const testing::SyntheticScene s =
-        testing::Render(Courtyard(argv[1], n, w, h, seed, points));
+    Require(w >= 16 && h >= 16, "make_scene: image size ", w, "x", h,
+            " is too small");
+    families::FamilyOptions fo;
+    fo.views = n;
+    fo.width = w;
+    fo.height = h;
+    fo.seed = seed;
+    fo.points = points;
+    const testing::SyntheticSpec spec =
+        kind == "relief" ? families::ReliefScene(fo)
+        : kind == "weak" ? families::WeakTextureScene(fo)
+                         : Courtyard(kind, n, w, h, seed, points);
+    const testing::SyntheticScene s = testing::Render(spec);
     testing::WriteDataset(s, argv[2]);
+    WritePly(std::string(argv[2]) + "/gt_surface.ply",
+             VoxelThin(s.GroundTruthCloud(2), 0.005));
     std::printf("%s: %d views %dx%d, %zu sparse points -> %s\n", argv[1], n, w,
                 h, s.scene.points.size(), argv[2]);
   } catch (const std::exception& e) {

@@ -13,6 +13,7 @@
 //    fixed light direction l (two-sided, so it does not depend on the
 //    viewer). Radiance lies in about [0.02, 0.40] so that exposures up to
 //    2.5 still mostly fit in [0, 1]. Background (no hit) radiance is 0.
+//    Views with a sun or overcast shade as ViewLighting describes.
 #include "synthetic_scene.h"
 
 #include <algorithm>
@@ -137,10 +138,16 @@ Eigen::Vector2d ValueNoise2(const Eigen::Vector3d& p, uint32_t seed) {
 Eigen::Vector3d Albedo(const SyntheticObject& o, const Eigen::Vector3d& base,
                        const Eigen::Vector3d& p) {
   const uint32_t seed = static_cast<uint32_t>(o.texture_seed) * 7919u + 1u;
-  const double lum = Fbm(p, o.texture_scale, seed);
+  double lum = Fbm(p, o.texture_scale, seed);
   const Eigen::Vector2d ch = ValueNoise2(
       p * (1.0 / o.texture_scale) + Eigen::Vector3d(3.3, 1.7, 9.1), seed + 77u);
-  const double c1 = ch.x(), c2 = ch.y();
+  double c1 = ch.x(), c2 = ch.y();
+  if (o.texture_contrast != 1.0) {
+    const double k = o.texture_contrast;
+    lum = 0.5 + k * (lum - 0.5);
+    c1 = 0.5 + k * (c1 - 0.5);
+    c2 = 0.5 + k * (c2 - 0.5);
+  }
   Eigen::Vector3d tint(1.0 + 0.5 * (c1 - 0.5), 1.0 - 0.25 * (c1 + c2 - 1.0),
                        1.0 + 0.5 * (c2 - 0.5));
   Eigen::Vector3d a = (0.06 + 0.94 * lum) * base.cwiseProduct(tint);
@@ -160,12 +167,68 @@ struct Hit {
   Eigen::Vector3d normal{0, 0, 0};  // world frame, unit, not yet oriented
 };
 
+// One plane wave of a relief height field: h += amp * sin(k . (u, v) + phase).
+struct ReliefWave {
+  Eigen::Vector2d k{0, 0};
+  double amp = 0, phase = 0;
+};
+
 // Prepared object (normalised axes, cached normal).
 struct Prepared {
   SyntheticObject obj;
   Eigen::Vector3d n{0, 0, 1};
   Eigen::Vector3d base{1, 1, 1};  // BaseColor(obj.texture_seed)
+  std::vector<ReliefWave> waves;  // kRelief
+  double max_slope = 0;           // kRelief: bound on |grad h|
 };
+
+// kRelief: the height h(u, v) and, when `grad` is set, its gradient.
+double ReliefHeight(const Prepared& pr, double u, double v,
+                    Eigen::Vector2d* grad) {
+  double h = 0;
+  if (grad) grad->setZero();
+  for (const ReliefWave& w : pr.waves) {
+    const double a = w.k.x() * u + w.k.y() * v + w.phase;
+    h += w.amp * std::sin(a);
+    if (grad) *grad += w.amp * std::cos(a) * w.k;
+  }
+  return h;
+}
+
+// kRelief waves: six plane waves, wavelengths 0.6 .. 1.7 relief_scale,
+// amplitudes ~ wavelength, scaled so that sum |amp| = relief_amplitude.
+void PrepareRelief(Prepared* pr) {
+  const SyntheticObject& o = pr->obj;
+  const uint32_t seed = static_cast<uint32_t>(o.relief_seed) * 104729u + 5u;
+  double sum = 0;
+  for (int k = 0; k < 6; ++k) {
+    const double wavelength =
+        o.relief_scale * (0.6 + 1.1 * Lattice(k, 1, 0, seed));
+    const double dir = M_PI * Lattice(k, 2, 0, seed);
+    ReliefWave w;
+    w.k =
+        (2 * M_PI / wavelength) * Eigen::Vector2d(std::cos(dir), std::sin(dir));
+    w.phase = 2 * M_PI * Lattice(k, 3, 0, seed);
+    w.amp = wavelength;
+    sum += w.amp;
+    pr->waves.push_back(w);
+  }
+  pr->max_slope = 0;
+  for (ReliefWave& w : pr->waves) {
+    w.amp *= o.relief_amplitude / sum;
+    pr->max_slope += w.amp * w.k.norm();
+  }
+}
+
+// Clips [*t0, *t1] to the slab |(o + t d) . axis| <= half; false if empty.
+bool ClipSlab(double q, double dq, double half, double* t0, double* t1) {
+  if (std::abs(dq) < 1e-15) return std::abs(q) <= half;
+  double a = (-half - q) / dq, b = (half - q) / dq;
+  if (a > b) std::swap(a, b);
+  *t0 = std::max(*t0, a);
+  *t1 = std::min(*t1, b);
+  return *t0 < *t1;
+}
 
 // Linear radiance of a surface point (view independent).
 Eigen::Vector3d Radiance(const Prepared& o, const Eigen::Vector3d& p,
@@ -250,6 +313,102 @@ void IntersectObject(const Prepared& pr, int index, const Eigen::Vector3d& o,
       hit->normal = (o + z * d - ob.center).normalized();
       return;
     }
+    case SyntheticObject::Type::kCylinder: {
+      const Eigen::Vector3d q = o - ob.center;
+      const double r = ob.size.x(), hz = ob.size.z();
+      double best = hit->z;
+      Eigen::Vector3d normal;
+      const double a = d.x() * d.x() + d.y() * d.y();
+      if (a > 1e-30) {  // the side
+        const double b = q.x() * d.x() + q.y() * d.y();
+        const double c = q.x() * q.x() + q.y() * q.y() - r * r;
+        const double disc = b * b - a * c;
+        if (disc >= 0) {
+          const double s = std::sqrt(disc);
+          for (const double z : {(-b - s) / a, (-b + s) / a}) {
+            if (!(z > kMinDepth) || z >= best) continue;
+            if (std::abs(q.z() + z * d.z()) > hz) continue;
+            best = z;
+            normal = Eigen::Vector3d(q.x() + z * d.x(), q.y() + z * d.y(), 0)
+                         .normalized();
+            break;
+          }
+        }
+      }
+      if (ob.capped && std::abs(d.z()) > 1e-15) {
+        for (const double side : {-1.0, 1.0}) {
+          const double z = (side * hz - q.z()) / d.z();
+          if (!(z > kMinDepth) || z >= best) continue;
+          const double x = q.x() + z * d.x(), y = q.y() + z * d.y();
+          if (x * x + y * y > r * r) continue;
+          best = z;
+          normal = Eigen::Vector3d(0, 0, side);
+        }
+      }
+      if (best >= hit->z) return;
+      hit->z = best;
+      hit->object = index;
+      hit->normal = normal;
+      return;
+    }
+    case SyntheticObject::Type::kRelief: {
+      // f(t) = w(t) - h(u(t), v(t)) along the ray, in the slab |w| <= A.
+      const Eigen::Vector3d q = o - ob.center;
+      const double qu = q.dot(ob.axis_u), qv = q.dot(ob.axis_v),
+                   qw = q.dot(pr.n);
+      const double du = d.dot(ob.axis_u), dv = d.dot(ob.axis_v),
+                   dw = d.dot(pr.n);
+      double t0 = kMinDepth, t1 = hit->z;
+      const double slab =
+          std::max(ob.relief_amplitude, 1e-9 * (ob.size.x() + ob.size.y()));
+      if (!ClipSlab(qw, dw, slab, &t0, &t1) ||
+          !ClipSlab(qu, du, ob.size.x(), &t0, &t1) ||
+          !ClipSlab(qv, dv, ob.size.y(), &t0, &t1))
+        return;
+      if (!std::isfinite(t1)) return;
+      auto f = [&](double t) {
+        return qw + t * dw -
+               ReliefHeight(pr, qu + t * du, qv + t * dv, nullptr);
+      };
+      // |f'| <= lip, so f keeps its sign for |f| / lip; steps of at least
+      // 1/512 of the interval bound the work (a sign change inside such a
+      // step and back is thinner than the relief's features).
+      const double lip =
+          std::abs(dw) + pr.max_slope * std::sqrt(du * du + dv * dv) + 1e-300;
+      const double min_step = (t1 - t0) / 512;
+      double ta = t0, fa = f(ta);
+      double root = -1;
+      if (fa == 0) root = ta;
+      while (root < 0 && ta < t1) {
+        const double tb =
+            std::min(t1, ta + std::max(std::abs(fa) / lip, min_step));
+        const double fb = f(tb);
+        if (fb == 0) {
+          root = tb;
+        } else if ((fa < 0) != (fb < 0)) {
+          double lo = ta, hi = tb;
+          for (int it = 0; it < 200 && hi - lo > 1e-12 * hi; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            const double fm = f(mid);
+            if ((fm < 0) == (fa < 0)) {
+              lo = mid;
+            } else {
+              hi = mid;
+            }
+          }
+          root = 0.5 * (lo + hi);
+        }
+        ta = tb;
+        fa = fb;
+      }
+      if (root < 0 || !(root > kMinDepth) || root >= hit->z) return;
+      Eigen::Vector2d g;
+      ReliefHeight(pr, qu + root * du, qv + root * dv, &g);
+      hit->z = root;
+      hit->object = index;
+      hit->normal = (pr.n - g.x() * ob.axis_u - g.y() * ob.axis_v).normalized();
+      return;
+    }
   }
 }
 
@@ -260,13 +419,16 @@ std::vector<Prepared> Prepare(const std::vector<SyntheticObject>& objects) {
     const std::string what = Msg("synthetic object ", i);
     Require(o.texture_scale > 0, what, ": texture_scale = ", o.texture_scale,
             " must be > 0");
+    Require(o.texture_contrast >= 0, what,
+            ": texture_contrast = ", o.texture_contrast, " must be >= 0");
     Require((o.size.array() > 0).all() ||
                 (o.type == SyntheticObject::Type::kSphere && o.size.x() > 0),
             what, ": size must be positive");
     Prepared p;
     p.obj = o;
     p.base = BaseColor(o.texture_seed);
-    if (o.type == SyntheticObject::Type::kPlane) {
+    if (o.type == SyntheticObject::Type::kPlane ||
+        o.type == SyntheticObject::Type::kRelief) {
       Require(o.axis_u.norm() > 0 && o.axis_v.norm() > 0 &&
                   o.axis_u.cross(o.axis_v).norm() > 1e-9,
               what, ": plane axes must be non-zero and not parallel");
@@ -275,6 +437,11 @@ std::vector<Prepared> Prepare(const std::vector<SyntheticObject>& objects) {
       p.obj.axis_v =
           (o.axis_v - o.axis_v.dot(p.obj.axis_u) * p.obj.axis_u).normalized();
       p.n = p.obj.axis_u.cross(p.obj.axis_v).normalized();
+    }
+    if (o.type == SyntheticObject::Type::kRelief) {
+      Require(o.relief_amplitude >= 0 && o.relief_scale > 0, what,
+              ": relief_amplitude must be >= 0 and relief_scale > 0");
+      PrepareRelief(&p);
     }
     out.push_back(p);
   }
@@ -361,15 +528,27 @@ void ExtendBounds(const SyntheticObject& o, Eigen::Vector3d* lo,
     *hi = hi->cwiseMax(p);
   };
   switch (o.type) {
-    case SyntheticObject::Type::kPlane: {
+    case SyntheticObject::Type::kPlane:
+    case SyntheticObject::Type::kRelief: {
       const Eigen::Vector3d u = o.axis_u.normalized() * o.size.x();
       const Eigen::Vector3d v = o.axis_v.normalized() * o.size.y();
-      add(o.center + u + v);
-      add(o.center + u - v);
-      add(o.center - u + v);
-      add(o.center - u - v);
+      const bool relief = o.type == SyntheticObject::Type::kRelief;
+      const Eigen::Vector3d n =
+          relief ? Eigen::Vector3d(o.relief_amplitude * u.cross(v).normalized())
+                 : Eigen::Vector3d::Zero();
+      for (const double s : {1.0, -1.0}) {
+        if (!relief && s < 0) break;
+        add(o.center + u + v + s * n);
+        add(o.center + u - v + s * n);
+        add(o.center - u + v + s * n);
+        add(o.center - u - v + s * n);
+      }
       break;
     }
+    case SyntheticObject::Type::kCylinder:
+      add(o.center - Eigen::Vector3d(o.size.x(), o.size.x(), o.size.z()));
+      add(o.center + Eigen::Vector3d(o.size.x(), o.size.x(), o.size.z()));
+      break;
     case SyntheticObject::Type::kBox:
       for (int k = 0; k < 8; ++k) {
         const Eigen::Vector3d s((k & 1) ? 1 : -1, (k & 2) ? 1 : -1,
@@ -385,6 +564,16 @@ void ExtendBounds(const SyntheticObject& o, Eigen::Vector3d* lo,
 }
 
 }  // namespace
+
+double ReliefHeight(const SyntheticObject& relief, double u, double v,
+                    Eigen::Vector2d* grad) {
+  Require(relief.type == SyntheticObject::Type::kRelief,
+          "ReliefHeight: the object is not a relief");
+  Prepared p;
+  p.obj = relief;
+  PrepareRelief(&p);
+  return ReliefHeight(p, u, v, grad);
+}
 
 // ------------------------------------------------------------------ render
 
@@ -413,11 +602,17 @@ SyntheticScene Render(const SyntheticSpec& spec, const SyntheticLens& lens) {
       spec.camera_centers.size(), " cameras");
   Require(spec.noise_sigma >= 0 && spec.sparse_pixel_noise >= 0,
           "synthetic spec: noise must be >= 0");
+  Require(spec.look_ats.empty() ||
+              spec.look_ats.size() == spec.camera_centers.size(),
+          "synthetic spec: look_ats has ", spec.look_ats.size(),
+          " entries for ", spec.camera_centers.size(), " cameras");
   for (const ViewLighting& l : spec.lighting) {
     Require(
         l.exposure > 0 && l.gamma > 0 && (l.white_balance.array() > 0).all(),
         "synthetic spec: lighting needs exposure, gamma and white "
         "balance > 0");
+    Require(l.ambient >= 0 && l.ambient <= 1,
+            "synthetic spec: ambient = ", l.ambient, " must be in [0, 1]");
   }
   const std::vector<Prepared> objs = Prepare(spec.objects);
   const int n = static_cast<int>(spec.camera_centers.size());
@@ -431,8 +626,10 @@ SyntheticScene Render(const SyntheticSpec& spec, const SyntheticLens& lens) {
     char name[32];
     std::snprintf(name, sizeof(name), "view_%03d.png", i);
     v.name = name;
-    v.camera = LookAtCamera(spec.camera_centers[i], spec.look_at, W, H,
-                            spec.focals.empty() ? spec.focal : spec.focals[i]);
+    v.camera =
+        LookAtCamera(spec.camera_centers[i],
+                     spec.look_ats.empty() ? spec.look_at : spec.look_ats[i], W,
+                     H, spec.focals.empty() ? spec.focal : spec.focals[i]);
     v.camera.fy = lens.focal_y_ratio * v.camera.fx;
     v.camera.cx += lens.principal_offset.x();
     v.camera.cy += lens.principal_offset.y();
@@ -492,7 +689,16 @@ SyntheticScene Render(const SyntheticSpec& spec, const SyntheticLens& lens) {
             if (s.object < 0) {
               if (!spec.sky) continue;
               const double elev = d.normalized().z();
-              Ls = (0.25 + 0.1 * elev) * Eigen::Vector3d(0.8, 0.9, 1.0);
+              Ls = (0.25 + 0.1 * elev) *
+                   (light.overcast ? Eigen::Vector3d(0.85, 0.85, 0.85)
+                                   : Eigen::Vector3d(0.8, 0.9, 1.0));
+            } else if (light.overcast) {
+              const Eigen::Vector3d X = C + s.z * d;
+              Eigen::Vector3d nw = s.normal;
+              if (nw.dot(d) > 0) nw = -nw;  // the side facing the camera
+              const double sky_light = 0.5 * (1.0 + nw.z());
+              Ls = 0.4 * (light.ambient + (1.0 - light.ambient) * sky_light) *
+                   Albedo(objs[s.object].obj, objs[s.object].base, X);
             } else if (sun.squaredNorm() > 0) {
               const Eigen::Vector3d X = C + s.z * d;
               Eigen::Vector3d nw = s.normal;
@@ -503,7 +709,7 @@ SyntheticScene Render(const SyntheticSpec& spec, const SyntheticLens& lens) {
                 const Hit sh = Cast(objs, i, X + 1e-6 * nw, sun);
                 lit = sh.object < 0 ? ndl : 0.0;
               }
-              Ls = 0.4 * (0.35 + 0.65 * lit) *
+              Ls = 0.4 * (light.ambient + (1.0 - light.ambient) * lit) *
                    Albedo(objs[s.object].obj, objs[s.object].base, X);
             } else {
               Ls = Radiance(objs[s.object], C + s.z * d, s.normal);

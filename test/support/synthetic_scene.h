@@ -1,8 +1,9 @@
 // Copyright wild_mvs authors. A small ray-casting renderer for tests.
 //
 // Builds scenes with exact ground truth: textured planes, slanted planes,
-// boxes and spheres, cameras around them, per-view exposure, white balance
-// and gamma changes, and occluders that appear in one view only. Every
+// boxes, spheres, cylinders and relief (displaced) rectangles, cameras
+// around them, per-view exposure, white balance, gamma, sun, ambient and
+// overcast changes, and occluders that appear in one view only. Every
 // algorithm test builds on it.
 #pragma once
 
@@ -19,13 +20,23 @@ namespace wild_mvs {
 namespace testing {
 
 struct SyntheticObject {
-  enum class Type { kPlane, kBox, kSphere };
+  enum class Type { kPlane, kBox, kSphere, kCylinder, kRelief };
   Type type = Type::kPlane;
   // kPlane: a rectangle centred at `center` spanned by the unit vectors
   //   axis_u, axis_v with half extents size.x(), size.y().
   // kBox: axis-aligned box centred at `center` (rotated by `rotation`),
   //   half extents size.
   // kSphere: centre `center`, radius size.x().
+  // kCylinder: vertical axis (world z) through `center`, radius size.x(),
+  //   half height size.z(); closed by two discs when `capped`.
+  // kRelief: the rectangle of kPlane displaced along its normal
+  //   n = axis_u x axis_v by a smooth height field h(u, v) (u, v the
+  //   coordinates along axis_u, axis_v from `center`): a sum of six plane
+  //   waves with wavelengths 0.6 .. 1.7 relief_scale, directions and phases
+  //   from relief_seed, |h| <= relief_amplitude. Rays are intersected by
+  //   Lipschitz-bounded marching and bisection to 1e-12 relative depth, the
+  //   normal is that of the analytic gradient, so ground-truth depth and
+  //   normals are those of the rendered surface.
   Eigen::Vector3d center{0, 0, 0};
   Eigen::Vector3d size{1, 1, 1};
   Eigen::Vector3d axis_u{1, 0, 0}, axis_v{0, 1, 0};
@@ -38,6 +49,14 @@ struct SyntheticObject {
   // rendering view `only_in_view` (a transient occluder: a person, a car);
   // the ground-truth depth of that view includes it, of other views not.
   int only_in_view = -1;
+  bool capped = true;             // kCylinder
+  double relief_amplitude = 0.0;  // kRelief: max |h| in world units
+  double relief_scale = 0.5;      // kRelief: feature size in world units
+  int relief_seed = 1;            // kRelief
+  // Albedo variation amplitude: 1 = the full texture; k scales the
+  // luminance and tint deviations from their mid values by k (0 = a
+  // uniform colour).
+  double texture_contrast = 1.0;
 };
 
 // Photometric change applied to one view's rendered linear radiance L
@@ -57,13 +76,22 @@ struct SyntheticObject {
 //    radiance of a point becomes 0.4 * albedo * (0.35 + 0.65 * max(0, n . l)
 //    * lit) with lit = 0 where another object casts a shadow (the shading
 //    and the shadows then differ between views lit from different sides,
-//    like photos taken at other times of day).
+//    like photos taken at other times of day). `ambient` is the 0.35 of
+//    that formula: radiance 0.4 * albedo * (ambient + (1 - ambient) * max(0,
+//    n . l) * lit);
+//  - overcast (no direct sun, only sky light; `sun` is ignored): radiance
+//    0.4 * albedo * (ambient + (1 - ambient) * (1 + n_z) / 2) with n the
+//    normal facing the camera and n_z its world up component (light from
+//    the upper hemisphere, no shadows), and a grey sky.
+// `ambient` matters only with a sun or overcast.
 struct ViewLighting {
   double exposure = 1.0;
   Eigen::Vector3d white_balance{1, 1, 1};
   double gamma = 1.0;
   double vignetting = 0.0;
   Eigen::Vector3d sun{0, 0, 0};
+  double ambient = 0.35;  // in [0, 1]
+  bool overcast = false;
 };
 
 struct SyntheticSpec {
@@ -80,6 +108,8 @@ struct SyntheticSpec {
   // horizontal (world z is up). See MakeRingCameras.
   std::vector<Eigen::Vector3d> camera_centers;
   Eigen::Vector3d look_at{0, 0, 0};
+  // Per-view targets (empty = `look_at` for all).
+  std::vector<Eigen::Vector3d> look_ats;
   std::vector<ViewLighting> lighting;  // per view; empty = all defaults
   double noise_sigma = 0.0;            // Gaussian image noise (linear units)
   bool quantize = true;                // 8-bit quantisation like a camera
@@ -115,6 +145,12 @@ struct SyntheticScene {
 };
 
 SyntheticScene Render(const SyntheticSpec& spec);
+
+// The height field h(u, v) of a kRelief object (see SyntheticObject) and,
+// when `grad` is set, its gradient (dh/du, dh/dv): the analytic surface the
+// renderer intersects.
+double ReliefHeight(const SyntheticObject& relief, double u, double v,
+                    Eigen::Vector2d* grad = nullptr);
 
 // `n` cameras on a circle of `radius` at `height` around the origin, looking
 // at the origin (an object ring like Middlebury's).
