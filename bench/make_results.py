@@ -174,14 +174,19 @@ def main():
            f"| load | {meta['load']} |"]
     skipped = [s for s in meta.get("skipped", "").split(",") if s]
     if skipped:
-        md.append(f"| not run | {', '.join(skipped)} |")
+        md.append(f"| not run | {', '.join(skipped)} (skipped) |")
+    failed = [s for s in meta.get("failed", "").split(",") if s]
+    if failed:
+        md.append(f"| failed | {', '.join(failed)} (see the run's log) |")
     md += ["", "CPU-s are whole-process user + sys seconds, so they stay comparable "
            "on a shared machine; wall time is not reported.", ""]
     readme = []
     peers_dir = os.path.join(root, "bench", "peers")
 
     # --- speed -------------------------------------------------------------
-    speed = read_tsv(os.path.join(out, "speed", "table.tsv"))
+    def state(name):  # what an absent section's table says
+        return "Failed in this run." if name in failed else "Not run."
+    speed = None if "speed" in failed else read_tsv(os.path.join(out, "speed", "table.tsv"))
     md += ["## Speed: templeSparseRing", ""]
     if speed:
         r = speed[0]
@@ -214,11 +219,12 @@ def main():
                        f"({count(r['correct'])} in {plain(r['cpu_s'])} CPU-s), "
                        f"peak RSS {plain(r['peak_rss_mb'], '{:.0f}')} MB"])
     else:
-        md += ["Not run.", ""]
+        md += [state("speed"), ""]
 
     # --- fountain ----------------------------------------------------------
     scenes = []
-    fountain = read_tsv(os.path.join(out, "fountain", "fountain.tsv"))
+    fountain = None if "fountain" in failed else read_tsv(
+        os.path.join(out, "fountain", "fountain.tsv"))
     md += ["## Quality: fountain-P11", ""]
     if fountain:
         f = fountain[0]
@@ -250,11 +256,12 @@ def main():
                        f"{pct(f['F@1cm'], 1)} / {pct(f['F@2cm'], 1)} / "
                        f"{pct(f['F@5cm'], 1)} at 1 / 2 / 5 cm"])
     else:
-        md += ["Not run.", ""]
+        md += [state("fountain"), ""]
 
     # --- scene families ----------------------------------------------------
     md += ["## Rendered scene families", ""]
-    fam_files = sorted(glob.glob(os.path.join(out, "families", "*.tsv")))
+    fam_files = [] if "families" in failed else sorted(
+        glob.glob(os.path.join(out, "families", "*.tsv")))
     if fam_files:
         md += [meta.get("families_note", ""), ""]
         covs, accs = [], []
@@ -291,14 +298,14 @@ def main():
                            f"{100 * min(accs):.1f}-{100 * max(accs):.1f} % of the estimates "
                            "within 1 % (family means)"])
     else:
-        md += ["Not run.", ""]
+        md += [state("families"), ""]
     if scenes:
         plot_quality(os.path.join(docs, "results_quality.png"), scenes)
         md += ["![coverage and errors per scene](results_quality.png)", ""]
 
     # --- scale ---------------------------------------------------------------
     md += ["## Scale: synthetic photo collections", ""]
-    scale = read_tsv(os.path.join(out, "scale", "scale.tsv"))
+    scale = None if "scale" in failed else read_tsv(os.path.join(out, "scale", "scale.tsv"))
     if scale:
         md += [f"`bench/run_scale.sh {meta.get('scale_args', '')}`: whole "
                "`wild_mvs reconstruct` (depth, consistency filter, fusion) of "
@@ -319,7 +326,7 @@ def main():
                        f"{plain(lo['peak_rss_mb'], '{:.0f}')}-"
                        f"{plain(hi['peak_rss_mb'], '{:.0f}')} MB"])
     else:
-        md += ["Not run.", ""]
+        md += [state("scale"), ""]
 
     with open(os.path.join(docs, "RESULTS.md"), "w") as f:
         f.write("\n".join(md).rstrip() + "\n")
