@@ -19,15 +19,18 @@ ALL+='|\b(third|fourth|fifth|sixth) session\b|\bthis session\x27s\b|\bsession of
 # In prose and scripts only (code may have variables called s12).
 PROSE='\bs[0-9]{2}b?\b'
 
-scan() {  # FILE...: prints FILE:LINE: TEXT for every hit
-  local f
+scan() {  # FILE...: prints FILE:LINE: TEXT for every hit (one grep per pattern)
+  local f prose=()
+  [ $# -gt 0 ] || return 0
+  grep -H -n -I -i -P -- "$ALL" "$@" 2>/dev/null
   for f in "$@"; do
-    grep -n -I -i -P -- "$ALL" "$f" 2>/dev/null | sed "s|^|$f:|"
     case "$f" in
-      *.md | *.txt | *.sh | *.py | *.yaml | *.launch | *.test | *.cmake | *.xml | CMakeLists.txt)
-        grep -n -I -P -- "$PROSE" "$f" 2>/dev/null | sed "s|^|$f:|" ;;
+      *.md | *.txt | *.sh | *.py | *.yaml | *.launch | *.test | *.cmake | *.xml | *CMakeLists.txt)
+        prose+=("$f") ;;
     esac
   done
+  [ ${#prose[@]} -eq 0 ] || grep -H -n -I -P -- "$PROSE" "${prose[@]}" 2>/dev/null
+  return 0
 }
 
 # Self-check: planted history is found, legitimate code is not.
