@@ -16,8 +16,8 @@
 //   with --gt:   completeness (fraction of ground-truth pixels with an
 //                estimate), fraction of the estimated pixels within 1 cm and
 //                2 cm and within 1 % of the true depth (and their count,
-//                correct_1pct: issue 12's "correct" on fountain-P11), median
-//                absolute error, over the pixels with ground truth.
+//                correct_1pct: "correct" on fountain-P11), median absolute
+//                error, over the pixels with ground truth.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,5 @@
-// Copyright wild_mvs authors. Where ground-truth coverage is lost (issue 11;
-// not a test): for a `wild_mvs reconstruct` folder and its dataset's ground
+// Copyright wild_mvs authors. Where ground-truth coverage is lost (not a
+// test): for a `wild_mvs reconstruct` folder and its dataset's ground
 // truth, every ground-truth pixel of every view is put in one class, pooled
 // over the views:
 //   final_ok / final_bad   the final map (OUT) has an estimate within 1 % /

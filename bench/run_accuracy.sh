@@ -19,14 +19,17 @@
 #   whole-process CPU seconds (user + sys of `reconstruct`, /usr/bin/time)
 #     and peak RSS.
 # Usage: bench/run_accuracy.sh [--out DIR] [--kinds "constant light ..."]
-#          [--views N] [--points P] [--threads N] [--skip-build] [--tag NAME]
-#          [-- EXTRA reconstruct ARGS]
+#          [--views N] [--size WxH] [--points P] [--threads N] [--skip-build]
+#          [--tag NAME] [-- EXTRA reconstruct ARGS]
+# --size WxH: the rendered images' size (default 640x480). DIR defaults to
+# bench/out/accuracy (ignored by git); rendered scenes are kept and reused.
 # --points P: sparse points of the rendered scenes (default 1500 with exact
 # visibility); 0 = none, reconstruct computes tracks from the images first.
 # Prints one table row per scene (and writes DIR/TAG.tsv).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-OUT=/tmp/wild_mvs_accuracy
+OUT="$ROOT/bench/out/accuracy"
+SIZE=640x480
 KINDS="constant light clutter scale"
 VIEWS=12
 POINTS=1500
@@ -39,6 +42,7 @@ while [ $# -gt 0 ]; do
     --out) OUT="$2"; shift 2 ;;
     --kinds) KINDS="$2"; shift 2 ;;
     --views) VIEWS="$2"; shift 2 ;;
+    --size) SIZE="$2"; shift 2 ;;
     --points) POINTS="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
     --skip-build) BUILD=0; shift ;;
@@ -52,17 +56,22 @@ if [ "$BUILD" = 1 ]; then
   mkdir -p "$BUILD_DIR"
   # shellcheck source=../scripts/common.sh
   source "$ROOT/scripts/common.sh"
-  JOBS="${JOBS:-2}" wild_mvs_build -DWILD_MVS_WITH_ROS=OFF >/dev/null
+  wild_mvs_configure -DWILD_MVS_WITH_ROS=OFF
+  cmake --build "$BUILD_DIR" -j"${JOBS:-2}" --target wild_mvs make_scene >/dev/null
 fi
+[[ "$SIZE" =~ ^([0-9]+)x([0-9]+)$ ]] || { echo "run_accuracy.sh: --size takes WxH, not '$SIZE'" >&2; exit 2; }
+WIDTH=${BASH_REMATCH[1]}
+HEIGHT=${BASH_REMATCH[2]}
 BIN="$BUILD_DIR/bin"
 mkdir -p "$OUT"
 TSV="$OUT/$TAG.tsv"
 printf 'scene\tcomplete@1%%\twithin0.5%%\twithin1%%\toff>5%%\tsky\tmedian_rel\trepresented\tF@1cm\tF@2cm\tF@5cm\tP@1cm\tR@1cm\tcloud_pts\tcpu_s\trss_mb\n' >"$TSV"
 for kind in $KINDS; do
-  scene="$OUT/scenes/${kind}_$VIEWS"
+  scene="$OUT/scenes/${kind}_${VIEWS}_$SIZE"
   [ "$POINTS" = 1500 ] || scene="${scene}_p$POINTS"
   if [ ! -f "$scene/sparse/points3D.txt" ]; then
-    "$BIN/make_scene" "$kind" "$scene" --views "$VIEWS" --points "$POINTS" >&2
+    "$BIN/make_scene" "$kind" "$scene" --views "$VIEWS" --points "$POINTS" \
+      --width "$WIDTH" --height "$HEIGHT" >&2
   fi
   gt="$scene/gt_cloud.ply"
   [ -f "$gt" ] || "$BIN/wild_mvs" eval make-gt-cloud --dataset "$scene" \

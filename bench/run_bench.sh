@@ -1,33 +1,39 @@
 #!/usr/bin/env bash
-# MVS benchmark (issue 12; not a test). Builds the ROS-free tree, then runs
-# the depth stage of `wild_mvs reconstruct` (whole process, default options,
-# the consistency filter included) on
-#   - templeSparseRing, all 16 views at 640x480, its colmap_sift_gt model;
+# Speed benchmark (not a test): the depth stage of `wild_mvs reconstruct`
+# (whole process, default options, the consistency filter included) on
+#   - templeSparseRing (data/templeSparseRing), all 16 views at 640x480,
+#     with the ground-truth cameras and SIFT tracks of
+#     DATASETS/middlebury_templeSparseRing/colmap_sift_gt where it exists
+#     (the input the peers of docs/RESULTS.md got), else with tracks
+#     computed from the images first (`--stages sparse`, not timed);
 #   - fountain-P11, all 11 views at 1536x1024 (--max-image-size 1536);
 # N times each (--runs, default 3) and reports the median of: CPU seconds
 # (user + sys of the whole process, /usr/bin/time), samples, correct
-# samples, correct samples per CPU second and peak RSS, beside the
-# reference implementation's (MVE dmrecon) figures from issue 12.
+# samples, correct samples per CPU second and peak RSS (docs/METHODS.md):
 #   temple   correct = inside the object's bounding box (README.txt) + 5 mm
 #            and consistent with another view's map within 0.5 % of depth;
 #   fountain correct = within 1 % of the ground-truth depth.
 # (both by bench_depth_stats). Raw outputs (the /usr/bin/time lines, logs,
-# stats) and table.tsv go to bench/results/<UTC date>-<tag>/ (commit them);
-# the depth maps to a temporary folder (--keep-maps to keep it).
+# stats) and table.tsv go to --results DIR (default bench/out/bench-<UTC
+# time>, ignored by git); the depth maps to a temporary folder (--keep-maps
+# to keep it).
 #
-# Usage: bench/run_bench.sh [--runs N] [--threads N] [--tag TAG]
-#            [--only temple|fountain] [--skip-build] [--results DIR]
-#            [--keep-maps] [-- EXTRA wild_mvs reconstruct ARGS]
+# Usage: bench/run_bench.sh [--runs N] [--threads N] [--only temple|fountain]
+#            [--temple-size PX] [--fountain-size PX] [--skip-build]
+#            [--results DIR] [--keep-maps] [-- EXTRA wild_mvs reconstruct ARGS]
+# --temple-size / --fountain-size: working size (longest side; defaults
+# 0 = as shipped, 640, and 1536).
 # Environment: WILD_MVS_DATASETS (default: ../shared/datasets of the repo),
-# BUILD_DIR (default: build-bench).
-# Cost: temple about 35 CPU-s per run, fountain about 300-450 CPU-s.
+# BUILD_DIR (default: build-bench; only the targets used are built).
+# Cost: temple about 35 CPU-s per run, fountain about 250-450 CPU-s.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 DATASETS="${WILD_MVS_DATASETS:-$ROOT/../shared/datasets}"
 THREADS=2
 RUNS=3
-TAG=""
 RESULTS=""
+TEMPLE_SIZE=0
+FOUNTAIN_SIZE=1536
 BUILD=1
 ONLY=""
 KEEP=0
@@ -36,7 +42,8 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --runs) RUNS="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
-    --tag) TAG="$2"; shift 2 ;;
+    --temple-size) TEMPLE_SIZE="$2"; shift 2 ;;
+    --fountain-size) FOUNTAIN_SIZE="$2"; shift 2 ;;
     --results) RESULTS="$2"; shift 2 ;;
     --skip-build) BUILD=0; shift ;;
     --only) ONLY="$2"; shift 2 ;;
@@ -50,7 +57,10 @@ case "$ONLY" in "" | temple | fountain) ;; *)
   exit 2 ;;
 esac
 [[ "$RUNS" =~ ^[1-9][0-9]*$ ]] || { echo "run_bench.sh: --runs must be >= 1" >&2; exit 2; }
-[ -d "$DATASETS" ] || { echo "run_bench.sh: no datasets at $DATASETS" >&2; exit 1; }
+if [ "$ONLY" != temple ] && [ ! -d "$DATASETS/strecha_fountain-P11" ]; then
+  echo "run_bench.sh: no $DATASETS/strecha_fountain-P11 (set WILD_MVS_DATASETS, or --only temple)" >&2
+  exit 1
+fi
 [ -x /usr/bin/time ] || { echo "run_bench.sh: needs /usr/bin/time (Debian package 'time')" >&2; exit 1; }
 # Its own ROS-free build folder, so the main build/ keeps its configuration.
 export BUILD_DIR="${BUILD_DIR:-$ROOT/build-bench}"
@@ -58,18 +68,25 @@ if [ "$BUILD" = 1 ]; then
   mkdir -p "$BUILD_DIR"
   # shellcheck source=../scripts/common.sh
   source "$ROOT/scripts/common.sh"
-  JOBS="${JOBS:-2}" wild_mvs_build -DWILD_MVS_WITH_ROS=OFF >/dev/null
+  wild_mvs_configure -DWILD_MVS_WITH_ROS=OFF
+  cmake --build "$BUILD_DIR" -j"${JOBS:-2}" --target wild_mvs bench_depth_stats >/dev/null
 fi
 BIN="$BUILD_DIR/bin"
-if [ -z "$RESULTS" ]; then
-  commit=$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)
-  RESULTS="$ROOT/bench/results/$(date -u +%Y-%m-%dT%H%M)-${TAG:-$commit}"
-fi
+[ -n "$RESULTS" ] || RESULTS="$ROOT/bench/out/bench-$(date -u +%Y%m%dT%H%M%S)"
 mkdir -p "$RESULTS"
 MAPS="$(mktemp -d /tmp/wild_mvs_bench.XXXXXX)"
 [ "$KEEP" = 1 ] || trap 'rm -rf "$MAPS"' EXIT
-T="$DATASETS/middlebury_templeSparseRing"
+T="$ROOT/data/templeSparseRing"
 F="$DATASETS/strecha_fountain-P11"
+# The temple's model: the GT cameras and tracks the peers got, else tracks
+# computed once from the shipped images (not timed).
+TMODEL="$DATASETS/middlebury_templeSparseRing/colmap_sift_gt"
+if [ "$ONLY" != fountain ] && [ ! -f "$TMODEL/images.txt" ]; then
+  TMODEL="$MAPS/temple_sparse/sparse"
+  echo "== temple: no $DATASETS/middlebury_templeSparseRing/colmap_sift_gt, computing tracks" >&2
+  "$BIN/wild_mvs" reconstruct "$T" "$MAPS/temple_sparse" --stages sparse \
+    --threads "$THREADS" >"$RESULTS/temple_sparse.log" 2>&1
+fi
 
 # field KEY FILE: value of KEY=... on the TOTAL line of a stats file.
 field() { grep '^TOTAL' "$2" | tr ' ' '\n' | sed -n "s/^$1=//p" | grep . || echo -; }
@@ -78,7 +95,8 @@ median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(
 
 {
   echo "# wild_mvs bench $(date -u +%FT%TZ), commit $(git -C "$ROOT" rev-parse HEAD 2>/dev/null || echo unknown)"
-  echo "# host $(uname -n), $(nproc) cores: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-)"
+  echo "# $(nproc) cores: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-)"
+  echo "# temple model $TMODEL, sizes temple $TEMPLE_SIZE fountain $FOUNTAIN_SIZE"
   echo "# threads $THREADS, runs $RUNS, extra args: ${EXTRA[*]+${EXTRA[*]}}"
   echo "# CPU SIMD flags: $(grep -m1 -o -w 'avx2\|avx512f' /proc/cpuinfo | tr '\n' ' ')"
   echo "# WILD_MVS_SIMD_TARGET=${WILD_MVS_SIMD_TARGET:-} (empty: the best the CPU has; the log says which)"
@@ -95,10 +113,10 @@ bench() {
     rm -rf "$out"
     local args=()
     if [ "$name" = temple ]; then
-      args=("$T" "$out" --model "$T/colmap_sift_gt" --images "$T")
+      args=("$T" "$out" --model "$TMODEL" --images "$T" --max-image-size "$TEMPLE_SIZE")
     else
       args=("$F" "$out" --model "$F/colmap_sift_gt" --images "$F/images"
-            --max-image-size 1536)
+            --max-image-size "$FOUNTAIN_SIZE")
     fi
     echo "== $name run $k/$RUNS: wild_mvs reconstruct ${args[*]} --stages depth --threads $THREADS ${EXTRA[*]+${EXTRA[*]}}" >&2
     /usr/bin/time -f "%U %S %M" -o "$base.time" \
@@ -106,7 +124,7 @@ bench() {
       --threads "$THREADS" ${EXTRA[@]+"${EXTRA[@]}"} >"$base.log" 2>&1 ||
       { echo "run_bench.sh: wild_mvs failed, see $base.log" >&2; exit 1; }
     if [ "$name" = temple ]; then
-      "$BIN/bench_depth_stats" "$T/colmap_sift_gt" "$T" "$out" \
+      "$BIN/bench_depth_stats" "$TMODEL" "$T" "$out" \
         --bbox -0.073568 0.021728 -0.012445 0.028855 0.181892 0.062736 \
         --margin 0.005 --consistency 0.005 >"$base.stats"
       corrects+=("$(field correct "$base.stats")")
@@ -133,17 +151,8 @@ bench() {
     "$(median "${rates[@]}")" "$(median "${rss[@]}")" >>"$TSV"
 }
 
-if [ -z "$ONLY" ] || [ "$ONLY" = temple ]; then
-  bench temple
-  # Issue 12: MVE dmrecon on the same input (rss not measured).
-  printf 'temple\treference_mve_dmrecon\t1\t210.8\t756591\t714859\t%.4f\t%.0f\t-\n' \
-    "$(echo "714859 / 756591" | bc -l)" "$(echo "714859 / 210.8" | bc -l)" >>"$TSV"
-fi
-if [ -z "$ONLY" ] || [ "$ONLY" = fountain ]; then
-  bench fountain
-  printf 'fountain\treference_mve_dmrecon\t1\t2044\t11300000\t%.0f\t0.9660\t%.0f\t-\n' \
-    "$(echo "0.966 * 11300000" | bc -l)" "$(echo "0.966 * 11300000 / 2044" | bc -l)" >>"$TSV"
-fi
+if [ -z "$ONLY" ] || [ "$ONLY" = temple ]; then bench temple; fi
+if [ -z "$ONLY" ] || [ "$ONLY" = fountain ]; then bench fountain; fi
 
 echo >&2
 column -t -s $'\t' "$TSV" >&2

@@ -1,7 +1,7 @@
 #!/bin/bash
 # Scores a reconstruct folder's fused cloud and mesh vertices against a
 # ground-truth cloud made from the dataset's ground-truth depth maps, and
-# prints one table (the fountain-P11 numbers of issue 4).
+# prints one table (fountain-P11's cloud figures, docs/METHODS.md).
 #
 #   bench/run_cloud_eval.sh [--bin WILD_MVS] [--tau LIST] [--gt GT.ply]
 #                           [--gt-stride N] [--gt-voxel V] [--reconstruct ARGS]
@@ -21,7 +21,7 @@
 #
 # Example (fountain-P11 at half resolution):
 #   bench/run_cloud_eval.sh --reconstruct "--max-image-size 1536" \
-#     /work/shared/datasets/strecha_fountain-P11 /tmp/fountain_1536
+#     ../shared/datasets/strecha_fountain-P11 /tmp/fountain_1536
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# OpenMVS (CPU) side by side with wild_mvs (issues 11 and 12; not a test).
+# OpenMVS (CPU) side by side with wild_mvs (not a test).
 # Runs OpenMVS, built separately (nothing of it is in this repository), on
 #   - templeSparseRing, all 16 views (640x480);
 #   - fountain-P11, all 11 views (3072x2048 images, depth maps at 1536x1024);
@@ -23,12 +23,12 @@
 # depth maps are converted by bench/dmap_to_wild_mvs.py into a wild_mvs
 # depth folder (OUT/NAME/wild) and scored there.
 #
-# Usage: bench/run_openmvs.sh [--threads N] [--out DIR] [--only temple|fountain]
+# Usage: bench/run_openmvs.sh [--openmvs-bin DIR] [--threads N] [--out DIR] [--only temple|fountain]
 #                             [--cloud] [--score-only] [-- EXTRA DensifyPointCloud ARGS]
 # --score-only: do not run OpenMVS, score the outputs already in OUT.
 # Writes OUT/NAME/summary.txt per dataset (and prints it).
-# Environment: OPENMVS_BIN (folder with InterfaceCOLMAP and DensifyPointCloud;
-#   default /work/ext/openmvs-build/bin), WILD_MVS_BIN (folder with wild_mvs
+# Environment: OPENMVS_BIN (required: the folder with OpenMVS's
+#   InterfaceCOLMAP and DensifyPointCloud; or --openmvs-bin DIR), WILD_MVS_BIN (folder with wild_mvs
 #   and bench_depth_stats; default devel/lib/wild_mvs of the repo, else
 #   build-bench/bin), WILD_MVS_DATASETS (default ../shared/datasets of the
 #   repo), GT_CLOUD (fountain GT cloud for --cloud; default
@@ -37,7 +37,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 DATASETS="${WILD_MVS_DATASETS:-$ROOT/../shared/datasets}"
-OPENMVS_BIN="${OPENMVS_BIN:-/work/ext/openmvs-build/bin}"
+OPENMVS_BIN="${OPENMVS_BIN:-}"
 if [ -z "${WILD_MVS_BIN:-}" ]; then
   WILD_MVS_BIN="$ROOT/devel/lib/wild_mvs"
   [ -x "$WILD_MVS_BIN/bench_depth_stats" ] || WILD_MVS_BIN="$ROOT/build-bench/bin"
@@ -51,6 +51,7 @@ EXTRA=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --threads) THREADS="$2"; shift 2 ;;
+    --openmvs-bin) OPENMVS_BIN="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --only) ONLY="$2"; shift 2 ;;
     --cloud) CLOUD=1; shift ;;
@@ -60,9 +61,15 @@ while [ $# -gt 0 ]; do
     *) echo "run_openmvs.sh: unknown option $1 (--help)" >&2; exit 2 ;;
   esac
 done
-for b in InterfaceCOLMAP DensifyPointCloud; do
-  [ -x "$OPENMVS_BIN/$b" ] || { echo "run_openmvs.sh: no $OPENMVS_BIN/$b (set OPENMVS_BIN)" >&2; exit 1; }
-done
+if [ "$SCORE_ONLY" = 0 ]; then
+  [ -n "$OPENMVS_BIN" ] || {
+    echo "run_openmvs.sh: set OPENMVS_BIN (or --openmvs-bin DIR) to the folder of OpenMVS's InterfaceCOLMAP and DensifyPointCloud" >&2
+    exit 2
+  }
+  for b in InterfaceCOLMAP DensifyPointCloud; do
+    [ -x "$OPENMVS_BIN/$b" ] || { echo "run_openmvs.sh: no $OPENMVS_BIN/$b (set OPENMVS_BIN)" >&2; exit 1; }
+  done
+fi
 for b in wild_mvs bench_depth_stats; do
   [ -x "$WILD_MVS_BIN/$b" ] || { echo "run_openmvs.sh: no $WILD_MVS_BIN/$b (set WILD_MVS_BIN)" >&2; exit 1; }
 done

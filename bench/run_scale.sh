@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Scale benchmark (issue 12): whole-process `wild_mvs reconstruct` (depth +
+# Scale benchmark (not a test): whole-process `wild_mvs reconstruct` (depth +
 # consistency filter + fusion) on synthetic photo collections of growing size
 # (bench/scenes/make_collection: random viewpoints, resolutions 320..1600 px,
 # light, exposure, clutter; JPEG; COLMAP model with sparse tracks), measured
@@ -10,7 +10,7 @@
 #                      [--threads 2] [--work /tmp/wild_mvs_scale]
 #                      [--image-cache-mb 64] [--map-cache-mb 64]
 #                      [--pending-mb 32] [--fusion-mb MAP+PENDING]
-#                      [--no-results] [--table-only] [--rss-trace]
+#                      [--results DIR] [--table-only] [--rss-trace]
 #                      [-- EXTRA_FLAGS...]
 #
 # Collections are rendered into WORK (never into the repository) once and
@@ -19,9 +19,8 @@
 # get their own model. Every run starts from an empty output folder. Prints a
 # table (views, CPU-s, CPU-s per view, of it ReconstructView's per view,
 # wall-s, peak RSS MB, samples, fused points, samples per view) and writes it
-# to bench/results/scale.tsv with the raw outputs (time -v, summary.json,
-# the log's summary lines) under bench/results/scale/ (--no-results: stdout
-# only). --table-only: no rendering or runs, the table of the runs already in
+# to WORK/scale.tsv; --results DIR: copies it there with the raw outputs
+# (time -v, summary.json, the log's summary lines). --table-only: no rendering or runs, the table of the runs already in
 # WORK (e.g. one size per invocation, then all sizes). --rss-trace: sample
 # the process's VmRSS every second into WORK/rssN.tsv (seconds, MB, the
 # log's last line: where the peak is), copied with the results. BUILD_DIR (default build/) holds bin/wild_mvs and bin/make_collection.
@@ -37,7 +36,7 @@ IMAGE_CACHE_MB=64
 MAP_CACHE_MB=64
 PENDING_MB=32
 FUSION_MB=""  # default: MAP_CACHE_MB + PENDING_MB
-RESULTS=1
+RESULTS=""
 TABLE_ONLY=0
 RSS_TRACE=0
 EXTRA=()
@@ -51,7 +50,7 @@ while [ $# -gt 0 ]; do
     --map-cache-mb) MAP_CACHE_MB="$2"; shift 2 ;;
     --pending-mb) PENDING_MB="$2"; shift 2 ;;
     --fusion-mb) FUSION_MB="$2"; shift 2 ;;
-    --no-results) RESULTS=0; shift ;;
+    --results) RESULTS="$2"; shift 2 ;;
     --table-only) TABLE_ONLY=1; shift ;;
     --rss-trace) RSS_TRACE=1; shift ;;
     --) shift; EXTRA=("$@"); break ;;
@@ -159,14 +158,14 @@ done
   printf '%s\n' "${rows[@]}"
 } >"$WORK/scale.tsv"
 cat "$WORK/scale.tsv"
-if [ "$RESULTS" = 1 ]; then
-  mkdir -p "$ROOT/bench/results/scale"
-  cp "$WORK/scale.tsv" "$ROOT/bench/results/scale.tsv"
+if [ -n "$RESULTS" ]; then
+  mkdir -p "$RESULTS"
+  cp "$WORK/scale.tsv" "$RESULTS/scale.tsv"
   for n in "${sizes[@]}"; do
-    cp "$WORK/time$n.txt" "$ROOT/bench/results/scale/time_$n.txt"
-    cp "$WORK/out$n/summary.json" "$ROOT/bench/results/scale/summary_$n.json"
-    [ ! -f "$WORK/rss$n.tsv" ] || cp "$WORK/rss$n.tsv" "$ROOT/bench/results/scale/rss_$n.tsv"
+    cp "$WORK/time$n.txt" "$RESULTS/time_$n.txt"
+    cp "$WORK/out$n/summary.json" "$RESULTS/summary_$n.json"
+    [ ! -f "$WORK/rss$n.tsv" ] || cp "$WORK/rss$n.tsv" "$RESULTS/rss_$n.tsv"
     grep -E '^(dataset|sparse|depth:|fuse|summary)' "$WORK/log$n.txt" \
-      >"$ROOT/bench/results/scale/log_$n.txt" || true
+      >"$RESULTS/log_$n.txt" || true
   done
 fi

@@ -32,12 +32,19 @@ if command -v ccache >/dev/null 2>&1; then
   CCACHE_ARGS=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
 
-wild_mvs_build() {  # extra cmake args...
+wild_mvs_configure() {  # extra cmake args...
   cmake -S "$WILD_MVS_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${CCACHE_ARGS[@]}" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@" >"$BUILD_DIR.cmake.log" 2>&1 \
     || { cat "$BUILD_DIR.cmake.log"; return 1; }
-  cmake --build "$BUILD_DIR" -j"$JOBS"
 }
+
+wild_mvs_build() {  # extra cmake args...: configure, then build everything
+  wild_mvs_configure "$@" && cmake --build "$BUILD_DIR" -j"$JOBS"
+}
+
+# What the demo runs: the tool, the two nodes, the bag converter and the
+# messages (finish_when_idle.py calls the fusion node's save service).
+WILD_MVS_DEMO_TARGETS=(wild_mvs depth_node fusion_node wild_mvs_to_bag wild_mvs_generate_messages)
 
 # The clang AddressSanitizer + UndefinedBehaviorSanitizer build (default
 # build-fuzz/): library, tool and tests sanitized, the library also with

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs what wild_mvs needs on Debian 12 (Debian's own ROS 1 packages), only when missing.
-# Usage: scripts/install_deps.sh [--no-ros] [--extra]
+# Usage: scripts/install_deps.sh [--no-ros] [--extra] [--bench]
 #   --no-ros   only the ROS-free core, I/O and CLI dependencies
 #   --extra    also fuzzing/sanitizer (clang) and rviz/Xvfb screenshot tools
+#   --bench    also what bench/run_all.sh needs (time, bc, matplotlib)
 set -eo pipefail
 export DEBIAN_FRONTEND=noninteractive
 CORE="build-essential cmake pkg-config git libgtest-dev libgmock-dev libeigen3-dev libopencv-dev \
@@ -19,11 +20,13 @@ ROS="catkin ros-message-generation ros-message-runtime \
  python3-geometry-msgs python3-std-srvs python3-diagnostic-msgs python3-numpy tf2-tools \
  python3-roslaunch pluginlib-dev libdepth-image-proc-dev python3-nav-msgs python3-tf2-ros python3-yaml"
 EXTRA="clang libclang-rt-14-dev libfuzzer-14-dev rviz xvfb xauth"
+BENCH="time bc python3-matplotlib"
 want="$CORE"
 for a in "$@"; do
   case "$a" in
     --no-ros) NO_ROS=1 ;;
     --extra) want="$want $EXTRA" ;;
+    --bench) want="$want $BENCH" ;;
     *) echo "install_deps.sh: unknown option '$a'" >&2; exit 2 ;;
   esac
 done

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job on the sample shipped in the repository: installs what is
-# missing (Debian 12 packages), builds, then runs wild_mvs on
+# missing (Debian 12 packages), builds what it runs (the tool and the ROS
+# nodes, no tests), then runs wild_mvs on
 # data/templeSparseRing (16 views, Middlebury): info, sparse tracks from the
 # known poses, depth maps, fused point cloud and mesh with the offline tool,
 # then the same sample through the ROS nodes (bag -> depth_node ->
@@ -22,20 +23,23 @@ while [ $# -gt 0 ]; do
     --full) SIZE=0 ;;
     --no-ros) NO_ROS=1 ;;
     --out) OUT="$2"; shift ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "run_demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
 done
 
+# Builds only what the demo runs (no tests: scripts/run_tests.sh builds them).
 if [ -n "${NO_ROS:-}" ]; then
   bash "$WILD_MVS_ROOT/scripts/install_deps.sh" --no-ros
   mkdir -p "$BUILD_DIR"
-  wild_mvs_build -DWILD_MVS_WITH_ROS=OFF
+  wild_mvs_configure -DWILD_MVS_WITH_ROS=OFF -DWILD_MVS_BUILD_TESTS=OFF
+  cmake --build "$BUILD_DIR" -j"$JOBS" --target wild_mvs
 else
   bash "$WILD_MVS_ROOT/scripts/install_deps.sh"
   mkdir -p "$BUILD_DIR"
-  wild_mvs_build -DWILD_MVS_WITH_ROS=ON
+  wild_mvs_configure -DWILD_MVS_WITH_ROS=ON -DWILD_MVS_BUILD_TESTS=OFF
+  cmake --build "$BUILD_DIR" -j"$JOBS" --target "${WILD_MVS_DEMO_TARGETS[@]}"
 fi
 WILD_MVS="$BUILD_DIR/bin/wild_mvs"
 DATA="$WILD_MVS_ROOT/data/templeSparseRing"

@@ -16,7 +16,9 @@ set -eo pipefail
 source "$(dirname "$0")/common.sh"
 bash "$WILD_MVS_ROOT/scripts/install_deps.sh" --extra
 mkdir -p "$BUILD_DIR"
-wild_mvs_build
+# Everything, with the tests and the ROS nodes (the demo's build folder
+# may have been configured without them).
+wild_mvs_build -DWILD_MVS_WITH_ROS=ON -DWILD_MVS_BUILD_TESTS=ON
 cmake --build "$BUILD_DIR" -j"$JOBS" --target tests 2>/dev/null || true  # catkin test targets
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$JOBS" | tee "$BUILD_DIR/ctest.log"
 # Tests that need ../shared skip (and show as skipped) without it; where it

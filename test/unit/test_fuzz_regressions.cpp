@@ -87,7 +87,7 @@ TEST(FuzzRegressions, BmpHeightInt32MinIsRefused) {
   std::filesystem::remove_all(dir);
 }
 
-// fuzz_ply, clean CI dry run of 2026-11-30: an ASCII face list entry of
+// fuzz_ply, found by a CI fuzz run: an ASCII face list entry of
 // 2.2e11 was cast to int before its range check (UBSan: float-cast-overflow
 // in ply.cpp). Now the file is refused, naming it and the face.
 TEST(FuzzRegressions, PlyFaceIndexOverIntMaxIsRefused) {

@@ -103,7 +103,7 @@ TEST(MvsRealTemple, FiveViewsCorrectSamples) {
         scene.views[refs[i]].Stem().c_str(), c.samples, c.in_box, c.consistent,
         c.correct, frac);
     // Per view: measured 7947..16410 correct samples, fractions 0.382..0.562
-    // (the plain window before c5f2fbe: 9825..18887, 0.402..0.571).
+    // (the plain window: 9825..18887, 0.402..0.571).
     EXPECT_GT(c.correct, 7000) << scene.views[refs[i]].name;
     EXPECT_GT(frac, 0.34) << scene.views[refs[i]].name;
     total.samples += c.samples;
@@ -118,9 +118,9 @@ TEST(MvsRealTemple, FiveViewsCorrectSamples) {
       total.samples, total.in_box, in_box, total.consistent, total.correct,
       correct);
   // Measured: 126210 samples, 64188 correct; in the box 0.745, correct 0.509
-  // (the plain window before c5f2fbe: 142347, 73138, 0.724, 0.514; at this
+  // (the plain window: 142347, 73138, 0.724, 0.514; at this
   // 320 px size the bilateral window finds 12 % fewer correct samples, at
-  // 640 px 2.9 % fewer in less CPU time, docs/EVALUATION.md).
+  // 640 px 2.9 % fewer in less CPU time).
   EXPECT_GT(total.correct, 56000);
   EXPECT_GT(in_box, 0.61);
   EXPECT_GT(correct, 0.43);

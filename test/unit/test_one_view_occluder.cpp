@@ -1,5 +1,5 @@
-// Copyright wild_mvs authors. One-view occluders (issue 11, the `clutter`
-// scene; docs/EVALUATION.md, "One-view occluders"): view 0 alone sees a box
+// Copyright wild_mvs authors. One-view occluders (the `clutter`
+// scene of bench/run_accuracy.sh): view 0 alone sees a box
 // between the camera and the scene. Its neighbours see the ground and the
 // wall behind the box and agree with each other there, so a match of a box
 // pixel at the depth of the background (where region growing from the
@@ -115,7 +115,7 @@ Tally MatchPixels(const Scenes& s, const MpgcOptions& mo, bool box) {
   return t;
 }
 
-// The explain test as measured in docs/EVALUATION.md.
+// The explain test (docs/ALGORITHM.md, section 4).
 // The plain window (the test was measured before the bilateral window,
 // which by itself halves the growth into the box: see
 // ReconstructViewLeavesTheBoxEmpty).
@@ -247,7 +247,7 @@ TEST(OneViewOccluder, ReconstructViewLeavesTheBoxEmpty) {
 
 TEST(OneViewOccluder, OptionsCheckedAndPaperPresetOff) {
   MpgcOptions o;
-  // On by default, keeping the match (docs/EVALUATION.md).
+  // On by default, keeping the match (docs/ALGORITHM.md).
   EXPECT_EQ(o.explain_margin, 0);
   EXPECT_EQ(o.explain_below_ncc, 0.8);
   EXPECT_TRUE(o.explain_keeps_match);

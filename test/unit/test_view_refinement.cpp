@@ -144,7 +144,7 @@ TEST_F(ViewRefinement, IncreasesCompletenessWithoutLosingAccuracy) {
   ThreadPool pool(2);
   ImageCache cache(s.Loader(), 64);
   // The plain window, as measured. (With the bilateral window, the
-  // default since c5f2fbe, the first pass leaves the second nothing to add
+  // default, the first pass leaves the second nothing to add
   // here: view 3 0.872 -> 0.872, view 0 0.633 -> 0.633 complete; the
   // second pass is off by default.)
   MvsOptions options;

@@ -43,7 +43,7 @@ struct RegionGrowingOptions {
   // are scored with the NCC of the unoptimised window and MPGC runs from
   // the best this many of them (scoring above mpgc.drop_ncc). 0 = paper.
   int hypotheses = 0;
-  // (beyond the paper, PatchMatch-style; issue 12) Before the first MPGC at
+  // (beyond the paper, PatchMatch-style) Before the first MPGC at
   // a pixel that holds nothing yet, the plane copied from the popped
   // neighbour and the planes of the pixel's other reconstructed
   // 4-neighbours are scored with the NCC of the unoptimised window (mean of

@@ -1,0 +1,355 @@
+#!/usr/bin/env python3
+"""Writes docs/RESULTS.md, its plots and README's results block from the raw
+outputs of one bench/run_all.sh run (not a test).
+
+    bench/make_results.py OUT_DIR ROOT
+
+OUT_DIR holds what run_all.sh wrote: meta.tsv (key, value), speed/table.tsv,
+fountain/fountain.tsv, families/*.tsv, scale/scale.tsv and, where the peers
+ran here, peers/*.tsv. A section whose file is missing is listed as not run.
+The peers' recorded figures come from bench/peers/*.tsv and are marked so.
+"""
+import csv
+import glob
+import os
+import re
+import sys
+
+BEGIN = "<!-- results:begin -->"
+END = "<!-- results:end -->"
+
+
+def read_tsv(path):
+    """Rows of a TSV file as dicts; lines starting with '#' are skipped."""
+    if not os.path.isfile(path):
+        return None
+    with open(path) as f:
+        lines = [l for l in f if l.strip() and not l.startswith("#")]
+    return list(csv.DictReader(lines, delimiter="\t", quoting=csv.QUOTE_NONE))
+
+
+def num(v):
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return None
+
+
+def pct(v, digits=2):
+    x = num(v)
+    return "-" if x is None else f"{100 * x:.{digits}f} %"
+
+
+def count(v):
+    x = num(v)
+    if x is None:
+        return "-"
+    if x >= 1e6:
+        return f"{x / 1e6:.2f} M"
+    return f"{x:,.0f}"
+
+
+def kilo(v):
+    x = num(v)
+    return "-" if x is None else f"{x / 1000:.1f} K"
+
+
+def plain(v, fmt="{:.1f}"):
+    x = num(v)
+    return "-" if x is None else fmt.format(x)
+
+
+def table(header, rows):
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(out)
+
+
+# Columns of the scene-family tables: label and formatter, by TSV name.
+FAMILY_COLUMNS = {
+    "scene": ("scene", str), "family": ("family", str), "seed": ("seed", str),
+    "complete@1%": ("coverage within 1 %", pct),
+    "cmp@1%": ("coverage within 1 %", pct), "in1%": ("within 1 %", pct),
+    "coverage": ("coverage", pct),
+    "within0.5%": ("within 0.5 %", pct), "within1%": ("within 1 %", pct),
+    "off>5%": ("off > 5 %", pct), "sky": ("sky", pct),
+    "background": ("background", pct),
+    "median_rel": ("median rel. error", lambda v: plain(v, "{:.5f}")),
+    "represented": ("represented", pct),
+    "F@1cm": ("F 1 cm", pct), "F@2cm": ("F 2 cm", pct),
+    "F@5cm": ("F 5 cm", pct), "P@1cm": ("P 1 cm", pct),
+    "R@1cm": ("R 1 cm", pct), "cloud_pts": ("cloud points", count),
+    "cpu_s": ("CPU-s", plain), "rss_mb": ("peak RSS MB", lambda v: plain(v, "{:.0f}")),
+}
+
+
+def family_table(rows):
+    cols = list(rows[0].keys())
+    header = [FAMILY_COLUMNS.get(c, (c, str))[0] for c in cols]
+    body = [[FAMILY_COLUMNS.get(c, (c, str))[1](r[c]) for c in cols] for r in rows]
+    return table(header, body)
+
+
+def first_key(row, names):
+    for n in names:
+        if n in row:
+            return n
+    return None
+
+
+def plot_quality(path, scenes):
+    """scenes: list of (name, coverage, within1, off5, background)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    names = [s[0] for s in scenes]
+    x = range(len(names))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 3.8))
+    w = 0.4
+    a.bar([i - w / 2 for i in x], [100 * s[1] for s in scenes], w, label="coverage")
+    a.bar([i + w / 2 for i in x], [100 * s[2] for s in scenes], w, label="estimates within 1 %")
+    a.set_ylim(0, 118)
+    a.set_ylabel("%")
+    a.set_title("coverage and accuracy")
+    b.bar([i - w / 2 for i in x], [100 * s[3] for s in scenes], w, label="off by more than 5 %",
+          color="tab:red")
+    b.bar([i + w / 2 for i in x], [100 * s[4] for s in scenes], w,
+          label="background / sky estimates", color="tab:gray")
+    b.set_ylabel("% of the estimates")
+    b.set_title("errors")
+    b.set_ylim(0, 1.25 * max([100 * max(s[3], s[4]) for s in scenes] + [0.1]))
+    for ax in (a, b):
+        ax.set_xticks(list(x))
+        ax.set_xticklabels(names, rotation=30, ha="right")
+        ax.legend(fontsize=8, loc="upper center", ncol=2)
+        ax.grid(axis="y", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_scale(path, rows):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    views = [int(r["views"]) for r in rows]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 3.5))
+    a.plot(views, [float(r["cpu_s_per_view"]) for r in rows], "o-", label="whole reconstruct")
+    a.plot(views, [float(r["mvs_cpu_s_per_view"]) for r in rows], "s--", label="depth maps only")
+    a.set_xlabel("views")
+    a.set_ylabel("CPU-s per view")
+    a.set_ylim(bottom=0)
+    a.legend(fontsize=8)
+    b.plot(views, [float(r["peak_rss_mb"]) for r in rows], "o-", color="tab:purple")
+    b.set_xlabel("views")
+    b.set_ylabel("peak RSS (MB)")
+    b.set_ylim(bottom=0)
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def main():
+    out, root = sys.argv[1], sys.argv[2]
+    meta = {r["key"]: r["value"] for r in read_tsv(os.path.join(out, "meta.tsv"))}
+    quick = meta.get("mode") == "quick"
+    # The command as a reader would repeat it (no local output folder).
+    command = re.sub(r" --out \S+| --skip-build", "", meta["command"])
+    docs = os.path.join(root, "docs")
+    md = ["# Results", "",
+          f"Generated by `{command}` from one run; do not edit by hand "
+          "(how each figure is measured: [METHODS.md](METHODS.md)).", ""]
+    if quick:
+        md += ["> **Quick setting**: smaller working sizes, smaller collections and "
+               "one run each, so that the whole set ends in minutes. These figures check that "
+               "the benchmarks work; they are not the full setting's and not "
+               "comparable with the peers' figures. `bench/run_all.sh` without "
+               "`--quick` gives the full set.", ""]
+    md += ["| | |", "|---|---|",
+           f"| machine | {meta['cpu']}, {meta['cores']} cores, {meta['memory']} RAM, "
+           f"Linux {meta['kernel']} |",
+           f"| commit | {meta['commit']} |", f"| date | {meta['date']} |",
+           f"| setting | {meta['setting']} |",
+           f"| load | {meta['load']} |"]
+    skipped = [s for s in meta.get("skipped", "").split(",") if s]
+    if skipped:
+        md.append(f"| not run | {', '.join(skipped)} (skipped) |")
+    failed = [s for s in meta.get("failed", "").split(",") if s]
+    if failed:
+        md.append(f"| failed | {', '.join(failed)} (see the run's log) |")
+    md += ["", "CPU-s are whole-process user + sys seconds, so they stay comparable "
+           "on a shared machine; wall time is not reported.", ""]
+    readme = []
+    peers_dir = os.path.join(root, "bench", "peers")
+
+    # --- speed -------------------------------------------------------------
+    def state(name):  # what an absent section's table says
+        return "Failed in this run." if name in failed else "Not run."
+    speed = None if "speed" in failed else read_tsv(os.path.join(out, "speed", "table.tsv"))
+    md += ["## Speed: templeSparseRing", ""]
+    if speed:
+        r = speed[0]
+        size = meta.get("temple_size", "640")
+        md += [f"Depth stage of `wild_mvs reconstruct` on `data/templeSparseRing` "
+               f"(16 views, working size {size} px, default options, "
+               f"`--threads {meta['threads']}`), median of {r['runs']} run(s). "
+               "Correct = inside the object's bounding box + 5 mm and consistent "
+               "with another view's map within 0.5 %.", ""]
+        rows = [["wild_mvs", size, plain(r["cpu_s"]), count(r["samples"]),
+                 count(r["correct"]), kilo(r["correct_per_cpu_s"]),
+                 plain(r["peak_rss_mb"], "{:.0f}"), "run here"]]
+        ran = read_tsv(os.path.join(out, "peers", "speed_temple.tsv")) or []
+        ran_names = {p["system"] for p in ran}
+        for p in ran:
+            rows.append([p["system"], p["size"], plain(p["cpu_s"]), count(p["samples"]),
+                         count(p["correct"]), kilo(p["correct_per_cpu_s"]),
+                         plain(p["peak_rss_mb"], "{:.0f}"), "run here"])
+        for p in read_tsv(os.path.join(peers_dir, "speed_temple.tsv")):
+            if p["system"] in ran_names:
+                continue
+            rows.append([p["system"], p["size"], plain(p["cpu_s"]), count(p["samples"]),
+                         count(p["correct"]), kilo(p["correct_per_cpu_s"]),
+                         plain(p["peak_rss_mb"], "{:.0f}"),
+                         f"recorded, not run here: {p['source']}"])
+        md += [table(["system", "px", "CPU-s", "samples", "correct",
+                      "correct per CPU-s", "peak RSS MB", "figures"], rows), ""]
+        readme.append([f"speed, templeSparseRing {size} px",
+                       f"{kilo(r['correct_per_cpu_s'])} correct samples per CPU-s "
+                       f"({count(r['correct'])} in {plain(r['cpu_s'])} CPU-s), "
+                       f"peak RSS {plain(r['peak_rss_mb'], '{:.0f}')} MB"])
+    else:
+        md += [state("speed"), ""]
+
+    # --- fountain ----------------------------------------------------------
+    scenes = []
+    fountain = None if "fountain" in failed else read_tsv(
+        os.path.join(out, "fountain", "fountain.tsv"))
+    md += ["## Quality: fountain-P11", ""]
+    if fountain:
+        f = fountain[0]
+        md += [f"`wild_mvs reconstruct` (depth maps and fused cloud, default options) "
+               f"of the 11 views at {f['size']} px on the longer side, against the "
+               "dataset's ground-truth depth; the fused cloud against a cloud of "
+               "the ground-truth depth (5 mm voxels).", ""]
+        def frow(name, r, how):
+            return [name, r["size"], pct(r["coverage"]), pct(r["within1%"]),
+                    pct(r["off>5%"]), pct(r["background"]),
+                    plain(r["median_abs_mm"]), pct(r["F@1cm"], 1), pct(r["F@2cm"], 1),
+                    pct(r["F@5cm"], 1), plain(r["cpu_s"]),
+                    plain(r["rss_mb"], "{:.0f}"), how]
+        rows = [frow("wild_mvs", f, "run here (depth + fusion)")]
+        ran = read_tsv(os.path.join(out, "peers", "fountain.tsv")) or []
+        ran_names = {p["system"] for p in ran}
+        rows += [frow(p["system"], p, "run here") for p in ran]
+        rows += [frow(p["system"], p, f"recorded, not run here: {p['source']}")
+                 for p in read_tsv(os.path.join(peers_dir, "fountain.tsv"))
+                 if p["system"] not in ran_names]
+        md += [table(["system", "px", "coverage", "within 1 %", "off > 5 %",
+                      "background", "median error mm", "F 1 cm", "F 2 cm", "F 5 cm",
+                      "CPU-s", "peak RSS MB", "figures"], rows), ""]
+        scenes.append(("fountain-P11", num(f["coverage"]), num(f["within1%"]),
+                       num(f["off>5%"]), num(f["background"])))
+        readme.append([f"fountain-P11 {f['size']} px vs ground truth",
+                       f"coverage {pct(f['coverage'], 1)}, {pct(f['within1%'], 1)} "
+                       f"within 1 %, {pct(f['off>5%'])} off > 5 %; fused cloud F "
+                       f"{pct(f['F@1cm'], 1)} / {pct(f['F@2cm'], 1)} / "
+                       f"{pct(f['F@5cm'], 1)} at 1 / 2 / 5 cm"])
+    else:
+        md += [state("fountain"), ""]
+
+    # --- scene families ----------------------------------------------------
+    md += ["## Rendered scene families", ""]
+    fam_files = [] if "families" in failed else sorted(
+        glob.glob(os.path.join(out, "families", "*.tsv")))
+    if fam_files:
+        md += [meta.get("families_note", ""), ""]
+        covs, accs = [], []
+        for path in fam_files:
+            rows = read_tsv(path)
+            if not rows:
+                continue
+            title = os.path.splitext(os.path.basename(path))[0]
+            md += [f"### {title}", "", family_table(rows), ""]
+            ck = first_key(rows[0], ["coverage", "complete@1%"])
+            ak = first_key(rows[0], ["in1%", "within1%"])
+            ok = first_key(rows[0], ["off>5%"])
+            sk = first_key(rows[0], ["sky", "background"])
+            nk = first_key(rows[0], ["scene", "family"])
+            if not (ck and ak and ok and sk):
+                continue
+            # One bar group per scene (mean over its seeds); the ranges of
+            # the README from the MEAN rows where there are any.
+            by_scene = {}
+            for r in rows:
+                if r.get(nk) == "MEAN":
+                    continue
+                by_scene.setdefault(r[nk] if nk else title, []).append(r)
+            for name, rs in by_scene.items():
+                mean = [sum(num(r[k]) for r in rs) / len(rs) for k in (ck, ak, ok, sk)]
+                label = name if name == title or len(fam_files) == 1 else f"{title}: {name}"
+                scenes.append(tuple([label] + mean))
+            means = [r for r in rows if r.get(nk) == "MEAN"] or rows
+            covs += [num(r[ck]) for r in means]
+            accs += [num(r[ak]) for r in means]
+        if covs:
+            readme.append(["rendered scene families (exact ground truth)",
+                           f"coverage {100 * min(covs):.1f}-{100 * max(covs):.1f} %, "
+                           f"{100 * min(accs):.1f}-{100 * max(accs):.1f} % of the estimates "
+                           "within 1 % (family means)"])
+    else:
+        md += [state("families"), ""]
+    if scenes:
+        plot_quality(os.path.join(docs, "results_quality.png"), scenes)
+        md += ["![coverage and errors per scene](results_quality.png)", ""]
+
+    # --- scale ---------------------------------------------------------------
+    md += ["## Scale: synthetic photo collections", ""]
+    scale = None if "scale" in failed else read_tsv(os.path.join(out, "scale", "scale.tsv"))
+    if scale:
+        md += [f"`bench/run_scale.sh {meta.get('scale_args', '')}`: whole "
+               "`wild_mvs reconstruct` (depth, consistency filter, fusion) of "
+               "collections of random viewpoints, 320-1600 px JPEGs, changing light "
+               "and clutter.", ""]
+        md += [table(["views", "CPU-s", "CPU-s per view", "depth maps: CPU-s per view",
+                      "peak RSS MB", "samples", "fused points"],
+                     [[r["views"], plain(r["cpu_s"]), plain(r["cpu_s_per_view"], "{:.3f}"),
+                       plain(r["mvs_cpu_s_per_view"], "{:.3f}"),
+                       plain(r["peak_rss_mb"], "{:.0f}"), count(r["samples"]),
+                       count(r["fused_points"])] for r in scale]), ""]
+        plot_scale(os.path.join(docs, "results_scale.png"), scale)
+        md += ["![CPU time and memory against the number of views](results_scale.png)", ""]
+        lo, hi = scale[0], scale[-1]
+        readme.append([f"scale, {lo['views']}-{hi['views']} synthetic views",
+                       f"{plain(lo['cpu_s_per_view'], '{:.2f}')}-"
+                       f"{plain(hi['cpu_s_per_view'], '{:.2f}')} CPU-s per view, peak RSS "
+                       f"{plain(lo['peak_rss_mb'], '{:.0f}')}-"
+                       f"{plain(hi['peak_rss_mb'], '{:.0f}')} MB"])
+    else:
+        md += [state("scale"), ""]
+
+    with open(os.path.join(docs, "RESULTS.md"), "w") as f:
+        f.write("\n".join(md).rstrip() + "\n")
+
+    # --- README block ----------------------------------------------------------
+    readme_path = os.path.join(root, "README.md")
+    text = open(readme_path).read()
+    if BEGIN in text and END in text:
+        block = [BEGIN, ""]
+        if quick:
+            block += ["*Quick setting (smaller sizes, one run): see the note in "
+                      "docs/RESULTS.md.*", ""]
+        block += [table(["benchmark", "today"], readme), "",
+                  f"{meta['cores']} cores ({meta['cpu']}), `--threads {meta['threads']}`; "
+                  "every table, the peers and the plots: "
+                  "[docs/RESULTS.md](docs/RESULTS.md), produced by "
+                  "`bash bench/run_all.sh`.", "", END]
+        pre, rest = text.split(BEGIN, 1)
+        post = rest.split(END, 1)[1]
+        with open(readme_path, "w") as f:
+            f.write(pre + "\n".join(block) + post)
+
+
+if __name__ == "__main__":
+    main()
