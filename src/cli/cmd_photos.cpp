@@ -197,7 +197,8 @@ SparseModel ChooseModel(const std::string& sparse_dir, size_t photos) {
   Require(!models.empty(), sparse_dir,
           ": COLMAP could not register any photos (no two photos with "
           "enough matches to start from): the photos must overlap, each "
-          "part of the scene seen from several positions");
+          "part of the scene seen from several positions; see ",
+          fs::path(sparse_dir).parent_path().string(), "/log/mapper.log");
   const SparseModel& best = models[0];
   if (models.size() > 1) {
     std::ostringstream parts;
@@ -308,11 +309,17 @@ int RunPhotos(const CommandArgs& argv) {
                "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads",
                threads});
     }
-    run.Run(3, "cameras and sparse points",
-            {"mapper", "--database_path", db, "--image_path", photo_dir,
-             "--output_path", sparse, "--Mapper.num_threads", threads,
-             "--Mapper.abs_pose_min_num_inliers", kMinPoseInliers,
-             "--Mapper.abs_pose_min_inlier_ratio", kMinPoseInlierRatio});
+    try {
+      run.Run(3, "cameras and sparse points",
+              {"mapper", "--database_path", db, "--image_path", photo_dir,
+               "--output_path", sparse, "--Mapper.num_threads", threads,
+               "--Mapper.abs_pose_min_num_inliers", kMinPoseInliers,
+               "--Mapper.abs_pose_min_inlier_ratio", kMinPoseInlierRatio});
+    } catch (const Error&) {
+      // The mapper fails when it finds no pair to start from: that is the
+      // "nothing registered" error below.
+      if (!ReadModels(sparse).empty()) throw;
+    }
     const SparseModel model = ChooseModel(sparse, photos.size());
     registered = model.images;
     sparse_points = model.points;

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <string>
 #include <vector>
@@ -118,6 +120,7 @@ TEST_F(ColmapPhotos, RegistersTheViewsAndReconstructs) {
       std::regex("photos summary: ([0-9]+) of 16 photos registered")))
       << photos_run_.output;
   EXPECT_GE(std::stoi(m[1]), 14) << photos_run_.output;
+  std::cout << m.str(0) << "\n";
   const Scene model = ReadColmapModel(ws_ + "/sparse");
   EXPECT_GE(model.views.size(), 14u);
   const PointCloud ours = ReadPlyCloud(out_ + "/fused.ply");
@@ -184,6 +187,11 @@ TEST_F(ColmapPhotos, ColmapFusionAndMeshersAcceptOurMaps) {
   const CloudMetrics cm = EvaluateCloud(theirs, ours, o);
   SCOPED_TRACE(cm.ToString());
   EXPECT_GE(cm.fscore[0], 0.9);
+  std::cout << "COLMAP's fusion of our maps (" << theirs.size()
+            << " points) vs our fused cloud (" << ours.size()
+            << " points) at tau " << tau << ": F " << cm.fscore[0]
+            << ", precision " << cm.precision[0] << ", recall " << cm.recall[0]
+            << "\n";
   // COLMAP's image indices are the model's order: each image a COLMAP
   // point lists sees it in our geometric map.
   const auto vis = ReadColmapVisibility(root_ + "/colmap_fused.ply.vis");
@@ -208,6 +216,51 @@ TEST_F(ColmapPhotos, ColmapFusionAndMeshersAcceptOurMaps) {
   ASSERT_EQ(poisson_ours_run_.status, 0) << poisson_ours_run_.output;
   EXPECT_GT(ReadPlyMesh(root_ + "/colmap_poisson_ours.ply").faces.size(),
             1000u);
+}
+
+// Without colmap, or with photos that COLMAP cannot connect: a clear error
+// and exit status 1, before or instead of any reconstruction.
+TEST(ColmapPhotosErrors, MissingColmapAndUnrelatedPhotos) {
+  const std::string root = testing::MakeTempDir("wild_mvs_photos_errors");
+  const std::string photos = root + "/photos";
+  fs::create_directories(photos);
+  cv::RNG rng(5);
+  for (int i = 0; i < 3; ++i) {  // noise: nothing matches between them
+    cv::Mat img(120, 160, CV_8UC3);
+    rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+    cv::imwrite(photos + "/noise" + std::to_string(i) + ".png", img);
+  }
+  const std::string cli = std::string("'") + WILD_MVS_CLI + "' photos '" +
+                          photos + "' '" + root + "/out' --threads 2";
+  RunResult r = RunCommand(cli + " --colmap /nonexistent/colmap");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("wild_mvs photos: /nonexistent/colmap: not an "
+                          "executable file"),
+            std::string::npos)
+      << r.output;
+  r = RunCommand(cli + " --colmap no-such-colmap-program");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("no-such-colmap-program: not found in PATH: "
+                          "install COLMAP (Debian: apt-get install colmap)"),
+            std::string::npos)
+      << r.output;
+  fs::create_directories(root + "/two");
+  fs::copy_file(photos + "/noise0.png", root + "/two/a.png");
+  r = RunCommand(std::string("'") + WILD_MVS_CLI + "' photos '" + root +
+                 "/two' '" + root + "/out'");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("1 photos (.jpg, .png, .tif, ...) found; at least 3"),
+            std::string::npos)
+      << r.output;
+  if (!cli::FindExecutable("colmap").empty()) {
+    r = RunCommand(cli);
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("COLMAP could not register any photos"),
+              std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(root + "/out/fused.ply"));
+  }
+  fs::remove_all(root);
 }
 
 }  // namespace
