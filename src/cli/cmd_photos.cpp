@@ -56,8 +56,9 @@ CommandSpec PhotosSpec() {
       "writes them; OUT/colmap: COLMAP's database, sparse models and logs;\n"
       "OUT/dense: COLMAP's dense workspace (undistorted images, the model,\n"
       "and stereo/depth_maps, stereo/normal_maps, fused.ply(.vis) in\n"
-      "COLMAP's formats, for colmap stereo_fusion, poisson_mesher,\n"
-      "delaunay_mesher). Needs the colmap program (apt-get install colmap).";
+      "COLMAP's formats, for colmap stereo_fusion, poisson_mesher and,\n"
+      "when colmap is built with CGAL, delaunay_mesher). Needs the colmap\n"
+      "program (apt-get install colmap).";
   s.positionals = {"PHOTO_DIR", "OUT"};
   s.min_positionals = 2;
   s.max_positionals = 2;
