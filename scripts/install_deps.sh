@@ -2,7 +2,7 @@
 # Installs what wild_mvs needs on Debian 12 (Debian's own ROS 1 packages), only when missing.
 # Usage: scripts/install_deps.sh [--no-ros] [--extra] [--bench]
 #   --no-ros   only the ROS-free core, I/O and CLI dependencies
-#   --extra    also fuzzing/sanitizer (clang) and rviz/Xvfb screenshot tools
+#   --extra    also fuzzing/sanitizer (clang), rviz/Xvfb screenshot tools and colmap (tests of the photos pipeline)
 #   --bench    also what bench/run_all.sh needs (time, bc, matplotlib)
 set -eo pipefail
 export DEBIAN_FRONTEND=noninteractive
@@ -19,7 +19,7 @@ ROS="catkin ros-message-generation ros-message-runtime \
  ros-core rosbash python3-rostest python3-rospy python3-rosbag python3-std-msgs python3-sensor-msgs \
  python3-geometry-msgs python3-std-srvs python3-diagnostic-msgs python3-numpy tf2-tools \
  python3-roslaunch pluginlib-dev libdepth-image-proc-dev python3-nav-msgs python3-tf2-ros python3-yaml"
-EXTRA="clang libclang-rt-14-dev libfuzzer-14-dev rviz xvfb xauth"
+EXTRA="clang libclang-rt-14-dev libfuzzer-14-dev rviz xvfb xauth colmap"
 BENCH="time bc python3-matplotlib"
 want="$CORE"
 for a in "$@"; do

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "wild_mvs/cli/args.h"
+#include "wild_mvs/cli/colmap_export.h"
 #include "wild_mvs/cli/commands.h"
 #include "wild_mvs/cli/option_command.h"
 #include "wild_mvs/cli/progress.h"
@@ -18,6 +19,7 @@
 #include "wild_mvs/core/mpgc_kernels.h"
 #include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/colmap.h"
+#include "wild_mvs/io/colmap_dense.h"
 #include "wild_mvs/io/image_files.h"
 
 namespace wild_mvs {
@@ -76,6 +78,13 @@ CommandSpec ReconstructSpec() {
       {"images", "DIR", "image folder (overrides detection)", ""},
       {"format", "NAME",
        "dataset format: auto|colmap|bundler|middlebury|strecha", ""},
+      {"colmap-workspace", "DIR",
+       "also write the maps and the cloud into this COLMAP dense workspace "
+       "as colmap patch_match_stereo and stereo_fusion would "
+       "(stereo/depth_maps, stereo/normal_maps, stereo/*.cfg, fused.ply, "
+       "fused.ply.vis); default: DATASET when it is one (images/, sparse/, "
+       "stereo/, as colmap image_undistorter writes); none = never",
+       ""},
   };
   s.epilog =
       "Option precedence: defaults < --preset < --config file < "
@@ -367,6 +376,23 @@ void FuseAndMeshStages(const Scene& scene, ImageCache* images,
   }
 }
 
+// The COLMAP dense workspace to write into: --colmap-workspace DIR, or the
+// dataset when it is one; "" = none.
+std::string ColmapWorkspace(const Args& args) {
+  if (args.Has("colmap-workspace")) {
+    const std::string dir = args.Get("colmap-workspace");
+    if (dir == "none") return "";
+    if (!IsColmapDenseWorkspace(dir)) {
+      throw UsageError(Msg("--colmap-workspace ", dir,
+                           ": not a COLMAP dense workspace (expected "
+                           "images/, stereo/ and a model in sparse/, as "
+                           "colmap image_undistorter writes)"));
+    }
+    return dir;
+  }
+  return IsColmapDenseWorkspace(args.positional(0)) ? args.positional(0) : "";
+}
+
 // The summary line on stdout and OUT/summary.json.
 void WriteSummary(const std::string& path, size_t views, const StageResults& r,
                   double secs, double cpu, int threads) {
@@ -434,6 +460,7 @@ int RunReconstruct(const CommandArgs& argv) {
   std::ostream& log = std::cerr;
 
   // Output folder and run record.
+  const std::string workspace = ColmapWorkspace(args);
   CreateOutputFolder(out);
   DatasetRecord record = MakeDatasetRecord(args);
   const EarlierRun earlier =
@@ -492,6 +519,10 @@ int RunReconstruct(const CommandArgs& argv) {
   } else {
     FuseAndMeshStages(scene, &images, config, &pool, out, force, earlier,
                       &results, log);
+    if (!workspace.empty()) {
+      ExportToColmapWorkspace(scene, views, out, workspace,
+                              config.fusion.depth_tolerance, log);
+    }
   }
 
   const double secs =

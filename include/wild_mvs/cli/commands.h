@@ -26,6 +26,7 @@ const std::vector<Command>& AllCommands();
 int RunInfo(const CommandArgs& args);
 int RunSparse(const CommandArgs& args);
 int RunReconstruct(const CommandArgs& args);
+int RunPhotos(const CommandArgs& args);
 int RunFuse(const CommandArgs& args);
 int RunMesh(const CommandArgs& args);
 int RunEval(const CommandArgs& args);
