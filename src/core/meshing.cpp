@@ -165,11 +165,11 @@ Mesh MeshPointCloud(const PointCloud& cloud, const MeshingOptions& options,
   options.Check();
   MeshingStats stats;
   stats.input_points = cloud.size();
+  Require(cloud.size() >= 10, "meshing: the point cloud has only ",
+          cloud.size(), " points (need >= 10)");
   Require(cloud.has_normal() && cloud.normal.size() == cloud.size(),
           "meshing: the point cloud has no normals (", cloud.normal.size(),
           " normals for ", cloud.size(), " points)");
-  Require(cloud.size() >= 10, "meshing: the point cloud has only ",
-          cloud.size(), " points (need >= 10)");
   Require(!cloud.has_rgb() || cloud.rgb.size() == cloud.size(),
           "meshing: colour array size ", cloud.rgb.size(),
           " != ", cloud.size());
