@@ -206,6 +206,10 @@ TEST(OneViewOccluder, ReconstructViewLeavesTheBoxEmpty) {
   EXPECT_LT(b.box, a.box / 2);
   EXPECT_GT(b.within, a.within * 0.97);
 
+  auto print = [](const char* what, const Count& n) {
+    std::printf("%s: %d estimates on the box, %d elsewhere (%d within 1 %%)\n",
+                what, n.box, n.elsewhere, n.within);
+  };
   // mpgc.explain_keeps_match: an unexplained match keeps its depth but does
   // not expand. Growth stops at the box's edge as with the failing test,
   // and the weak but right matches elsewhere stay.
