@@ -61,13 +61,13 @@ int main(int argc, char** argv) {
       } else if (a == "--save") {
         save = next();
       } else if (a == "--grey") {
-        opt.use_color = false;
+        opt.ablation.color = false;
       } else if (a == "--no-lvs") {
-        opt.local.enabled = false;
+        opt.ablation.local_view_selection = false;
       } else if (a == "--no-normal") {
-        opt.mpgc.optimize_normal = false;
+        opt.ablation.optimize_normal = false;
       } else if (a == "--no-color-scale") {
-        opt.mpgc.optimize_color_scale = false;
+        opt.ablation.optimize_color_scale = false;
       } else if (a == "--revisit-margin") {
         opt.growing.revisit_margin = std::stod(next());
       } else if (a == "--min-views") {

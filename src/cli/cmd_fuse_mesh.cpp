@@ -47,14 +47,14 @@ int RunFuse(const CommandArgs& argv) {
   std::cerr << "dataset: " << scene.views.size() << " views from "
             << record.path << (has_record ? " (from run.yaml)" : "") << "\n";
   ThreadPool pool(config.run.threads);
-  ImageCache images(MakeSceneLoader(scene, config.image),
+  ImageCache images(MakeSceneLoader(scene, config.LoaderOptions()),
                     config.image.cache_mb);
   const std::string ply = args.Get("output", out + "/fused.ply");
   const double cpu0 = CpuSeconds();
   // Maps left in OUT/raw by `reconstruct --shard` runs: the consistency
   // filter first (it needs every neighbour's raw map).
   const FilterStageResult f =
-      FilterPendingViews(scene, images, config.mvs, out, &pool, std::cerr);
+      FilterPendingViews(scene, config.mvs, out, &pool, std::cerr);
   if (f.filtered > 0) {
     std::cout << "filtered " << f.filtered << " depth maps (kept " << f.kept
               << " of " << f.samples << " samples)\n";

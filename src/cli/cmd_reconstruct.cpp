@@ -49,7 +49,7 @@ CommandSpec ReconstructSpec() {
        ""},
       {"preset", "NAME",
        "start from a preset: default, or paper (Goesele et al. 2007 as "
-       "published: no acceptance threshold, texture guard, step control or "
+       "published: plain windows, no explain test, photometric offset or "
        "consistency filter)",
        ""},
       {"dump-config", "", "print the effective options as YAML and exit", ""},
@@ -306,7 +306,7 @@ void DepthStage(Scene* scene, const std::vector<int>& views, ImageCache& images,
                 const std::vector<std::string>& fingerprint,
                 const std::string& dataset, StageResults* r,
                 std::ostream& log) {
-  const bool raw_counts = shard && config.mvs.consistency.enabled;
+  const bool raw_counts = shard && config.mvs.ablation.consistency;
   int todo = 0;
   for (int v : views) {
     const std::string stem = scene->views[v].Stem();
@@ -346,7 +346,7 @@ void FuseAndMeshStages(const Scene& scene, ImageCache* images,
   if (config.run.HasStage("fuse")) {
     // Maps that --shard runs left in OUT/raw are filtered first.
     const FilterStageResult pending =
-        FilterPendingViews(scene, *images, config.mvs, out, pool, log);
+        FilterPendingViews(scene, config.mvs, out, pool, log);
     if (!force && r->depth.computed == 0 && pending.filtered == 0 &&
         !earlier.fusion_options_changed && fs::exists(fused)) {
       log << "fuse: " << fused
@@ -494,7 +494,7 @@ int RunReconstruct(const CommandArgs& argv) {
 
   // Stages.
   ThreadPool pool(config.run.threads);
-  ImageCache images(MakeSceneLoader(scene, config.image),
+  ImageCache images(MakeSceneLoader(scene, config.LoaderOptions()),
                     config.image.cache_mb);
   StageResults results;
   const std::vector<std::string> fingerprint =

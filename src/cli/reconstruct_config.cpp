@@ -62,6 +62,11 @@ void RegisterOptions(ReconstructConfig* c, OptionRegistry* registry) {
   RegisterOptions(registry, "tracker", &c->tracker);
   // Per-view depth maps (Goesele et al. 2007).
   RegisterOptions(registry, "mvs", &c->mvs);
+  // The filter of the finished depth maps (not the depth node's).
+  RegisterOptions(registry, "consistency", &c->mvs.consistency);
+  // Parts of the method turned off for experiments (--preset paper sets
+  // some); the depth node does not register them.
+  RegisterOptions(registry, "ablation", &c->mvs.ablation);
   // Fusion of the depth maps into one point cloud.
   RegisterOptions(registry, "fusion", &c->fusion);
   // Poisson mesh of the fused cloud.

@@ -74,7 +74,7 @@ SparseSummary ComputeSceneTracks(Scene* scene, const ReconstructConfig& config,
   const auto t0 = Clock::now();
   log << "sparse: computing tracks from the known poses of "
       << scene->views.size() << " views..." << std::endl;
-  ImageCache images(MakeSceneLoader(*scene, config.image),
+  ImageCache images(MakeSceneLoader(*scene, config.LoaderOptions()),
                     config.image.cache_mb);
   TrackerStats stats;
   scene->points =
@@ -157,8 +157,7 @@ DepthStageResult RunDepthStage(const Scene& scene,
   DepthStageResult r;
   // With the consistency filter the MVS maps go to OUT/raw first; the
   // filter writes the final maps to OUT.
-  const GeometricConsistencyOptions& gc = config.mvs.consistency;
-  const bool filter = gc.enabled;
+  const bool filter = config.mvs.ablation.consistency;
   const std::string raw = filter ? out + "/raw" : out;
   Progress progress("depth", static_cast<int>(views.size()), log,
                     StderrIsTerminal());
@@ -234,8 +233,8 @@ DepthStageResult RunDepthStage(const Scene& scene,
   if (filter && !filter_now) {
     r.unfiltered = static_cast<int>(to_filter.size());
   } else if (filter && !to_filter.empty()) {
-    FilterStageResult f = FinishDepthMaps(scene, to_filter, images, config.mvs,
-                                          pool, out, log, &points_per_view);
+    FilterStageResult f = FilterDepthMaps(
+        scene, to_filter, config.mvs.consistency, out + "/raw", out, pool, log);
     ReleaseFreeMemory();
     r.computed += f.filtered;
     r.samples += f.kept;
@@ -252,9 +251,8 @@ FilterStageResult FilterDepthMaps(const Scene& scene,
                                   const GeometricConsistencyOptions& options,
                                   const std::string& raw,
                                   const std::string& out, ThreadPool* pool,
-                                  std::ostream& log, const std::string& member,
-                                  const std::string& earlier,
-                                  int min_consistent_new) {
+                                  std::ostream& log,
+                                  const std::string& member) {
   options.Check();
   FilterStageResult r;
   std::map<std::string, int> by_name;
@@ -288,11 +286,7 @@ FilterStageResult FilterDepthMaps(const Scene& scene,
       std::vector<const DepthMap*> ptrs;
       for (const DepthMapFiles& n : nbs) ptrs.push_back(&n.map);
       job.neighbor_maps = static_cast<int>(ptrs.size());
-      cv::Mat before;
-      if (!earlier.empty())
-        before = ReadDepthMapFiles(earlier, view.Stem()).map.depth;
-      FilterByConsistency(&job.ref.map, ptrs, options, &job.stats, before,
-                          min_consistent_new);
+      FilterByConsistency(&job.ref.map, ptrs, options, &job.stats);
     } catch (const Error& e) {
       job.error = e.what();
     }
@@ -348,125 +342,11 @@ FilterStageResult FilterDepthMaps(const Scene& scene,
   return r;
 }
 
-RefineStageResult RefineDepthMaps(
-    const Scene& scene, const std::vector<int>& views, ImageCache& images,
-    const MvsOptions& mvs, const std::string& in, const std::string& out,
-    ThreadPool* pool, std::ostream& log,
-    const std::vector<std::vector<int>>* points_per_view) {
-  RefineStageResult r;
-  std::map<std::string, int> by_name;
-  for (size_t i = 0; i < scene.views.size(); ++i)
-    by_name[scene.views[i].name] = static_cast<int>(i);
-  const int total = static_cast<int>(views.size());
-  Progress progress("refine", total, log, StderrIsTerminal());
-  for (int k = 0; k < total; ++k) {
-    const View& view = scene.views[views[k]];
-    const std::string stem = view.Stem();
-    const std::string prefix = Msg("refine ", k + 1, "/", total, " ", stem);
-    progress.Begin(stem);
-    DepthMapFiles own;
-    DepthMap map;
-    ViewReport report;
-    int neighbor_maps = 0;
-    try {
-      own = ReadDepthMapFiles(in, stem);
-      std::vector<DepthMapFiles> nbs;
-      for (const std::string& name : own.neighbor_names) {
-        auto it = by_name.find(name);
-        if (it == by_name.end()) continue;
-        const std::string nstem = scene.views[it->second].Stem();
-        if (!ViewOutputsComplete(in, nstem)) continue;
-        nbs.push_back(ReadDepthMapFiles(in, nstem));
-      }
-      std::vector<const DepthMap*> ptrs;
-      for (const DepthMapFiles& n : nbs) ptrs.push_back(&n.map);
-      neighbor_maps = static_cast<int>(ptrs.size());
-      map = RefineView(scene, views[k], images, mvs, own.map, ptrs, pool,
-                       &report, LoadViewMask(view), points_per_view);
-    } catch (const Error& e) {
-      r.failures.push_back(Msg(view.name, ": ", e.what()));
-      progress.End(Msg(prefix, ": FAILED: ", e.what()));
-      continue;
-    }
-    const int valid = map.CountValid();
-    const std::string extra =
-        Msg("\n  \"refinement\": {\"samples_before\": ", report.start_samples,
-            ", \"samples\": ", valid,
-            ", \"held_seeds\": ", report.refine_seeds.held,
-            ", \"neighbor_seeds\": ", report.refine_seeds.neighbor,
-            ", \"seeds_accepted\": ", report.seeds_accepted,
-            ", \"pixel_visits\": ", report.pixel_visits,
-            ", \"neighbor_maps\": ", neighbor_maps,
-            ", \"cpu_seconds\": ", report.cpu_seconds, "},");
-    static const std::regex samples_re("\"samples\": [0-9]+");
-    const std::string body = std::regex_replace(
-        StripViewHeader(ReadText(LogPath(in, stem))), samples_re,
-        Msg("\"samples\": ", valid), std::regex_constants::format_first_only);
-    WriteViewOutputs(view, out, map, own.neighbor_names, body, extra);
-    ++r.refined;
-    r.samples_before += report.start_samples;
-    r.samples += valid;
-    progress.End(Msg(prefix, ": ", report.start_samples, " -> ", valid,
-                     " samples (", report.refine_seeds.held, " held + ",
-                     report.refine_seeds.neighbor, " neighbour seeds, ",
-                     report.seeds_accepted, " accepted), ",
-                     Progress::FormatDuration(report.seconds)));
-  }
-  progress.Finish();
-  return r;
-}
-
-FilterStageResult FinishDepthMaps(
-    const Scene& scene, const std::vector<int>& views, ImageCache& images,
-    const MvsOptions& mvs, ThreadPool* pool, const std::string& out,
-    std::ostream& log, const std::vector<std::vector<int>>* points_per_view) {
-  const std::string raw = out + "/raw";
-  if (!mvs.refine.enabled)
-    return FilterDepthMaps(scene, views, mvs.consistency, raw, out, pool, log);
-  // Each step skips the views whose output of that step is complete.
-  auto todo = [&](const std::string& dir) {
-    std::vector<int> v;
-    for (int i : views)
-      if (!ViewOutputsComplete(dir, scene.views[i].Stem())) v.push_back(i);
-    return v;
-  };
-  const std::string first = out + "/filtered1", refined = out + "/refined";
-  FilterStageResult r;
-  const std::vector<int> to_filter = todo(first);
-  if (!to_filter.empty()) {
-    const FilterStageResult f1 =
-        FilterDepthMaps(scene, to_filter, mvs.consistency, raw, first, pool,
-                        log, "consistency_first_pass");
-    r.failures = f1.failures;
-    ReleaseFreeMemory();
-  }
-  const std::vector<int> to_refine = todo(refined);
-  if (!to_refine.empty()) {
-    const RefineStageResult g =
-        RefineDepthMaps(scene, to_refine, images, mvs, first, refined, pool,
-                        log, points_per_view);
-    for (const std::string& e : g.failures) r.failures.push_back(e);
-    log << "refine: " << g.refined << " views, " << g.samples_before << " -> "
-        << g.samples << " samples" << std::endl;
-    ReleaseFreeMemory();
-  }
-  const FilterStageResult f2 =
-      FilterDepthMaps(scene, views, mvs.consistency, refined, out, pool, log,
-                      "consistency", first, mvs.refine.min_consistent_new);
-  r.filtered = f2.filtered;
-  r.samples = f2.samples;
-  r.kept = f2.kept;
-  for (const std::string& e : f2.failures) r.failures.push_back(e);
-  return r;
-}
-
-FilterStageResult FilterPendingViews(const Scene& scene, ImageCache& images,
-                                     const MvsOptions& mvs,
+FilterStageResult FilterPendingViews(const Scene& scene, const MvsOptions& mvs,
                                      const std::string& out, ThreadPool* pool,
                                      std::ostream& log) {
-  const GeometricConsistencyOptions& options = mvs.consistency;
   FilterStageResult r;
-  if (!options.enabled) return r;
+  if (!mvs.ablation.consistency) return r;
   const std::string raw = out + "/raw";
   std::vector<int> pending;
   int missing = 0;
@@ -491,9 +371,7 @@ FilterStageResult FilterPendingViews(const Scene& scene, ImageCache& images,
            "shard before 'wild_mvs fuse')"
         << std::endl;
   }
-  const std::vector<std::vector<int>> points_per_view = scene.PointsPerView();
-  r = FinishDepthMaps(scene, pending, images, mvs, pool, out, log,
-                      &points_per_view);
+  r = FilterDepthMaps(scene, pending, mvs.consistency, raw, out, pool, log);
   if (!r.failures.empty()) {
     std::string list;
     for (const std::string& f : r.failures) list += "\n  " + f;
@@ -514,7 +392,8 @@ std::vector<std::string> TracksFingerprint(const OptionSet& options,
   std::vector<std::string> f;
   for (const auto& o : options.options()) {
     const std::string& key = o.key();
-    if (key.rfind("tracker.", 0) == 0 || key.rfind("image.", 0) == 0) {
+    if (key.rfind("tracker.", 0) == 0 || key.rfind("image.", 0) == 0 ||
+        key == "ablation.linearize") {
       if (key == "image.cache_mb") continue;
       f.push_back(key + " " + o.Text());
     }

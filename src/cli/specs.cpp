@@ -66,7 +66,7 @@ CommandSpec FuseSpec() {
       "dataset (for colours) is the one recorded in OUT/run.yaml unless\n"
       "--dataset is given. Views matched by 'reconstruct --shard K/N' runs\n"
       "(OUT/raw) are first given the geometric-consistency filter\n"
-      "(mvs.consistency.*), which writes their final maps to OUT.";
+      "(consistency.*), which writes their final maps to OUT.";
   s.positionals = {"OUT"};
   s.min_positionals = s.max_positionals = 1;
   s.flags = {

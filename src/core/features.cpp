@@ -11,19 +11,19 @@
 #include "wild_mvs/core/image.h"
 
 namespace wild_mvs {
+namespace {
+// OpenCV SIFT: contrastThreshold below OpenCV's 0.04 (more features on
+// weakly textured objects such as the Middlebury plaster models); Lowe's
+// edge threshold, layers per octave and base sigma.
+constexpr double kContrastThreshold = 0.02;
+constexpr double kEdgeThreshold = 10;
+constexpr int kOctaveLayers = 3;
+constexpr double kSigma = 1.6;
+}  // namespace
 
 void FeatureOptions::Check() const {
   Require(max_features >= 0, "features.max_features = ", max_features,
           " must be >= 0 (0 = no cap)");
-  Require(contrast_threshold > 0 && contrast_threshold < 1,
-          "features.contrast_threshold = ", contrast_threshold,
-          " must be in (0, 1)");
-  Require(edge_threshold > 0, "features.edge_threshold = ", edge_threshold,
-          " must be > 0");
-  Require(octave_layers >= 1 && octave_layers <= 10,
-          "features.octave_layers = ", octave_layers, " must be in [1, 10]");
-  Require(sigma > 0 && sigma < 10, "features.sigma = ", sigma,
-          " must be in (0, 10)");
   Require(downscale >= 1 && downscale <= 64, "features.downscale = ", downscale,
           " must be in [1, 64]");
   Require(max_image_size == 0 || max_image_size >= 64,
@@ -41,21 +41,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "keep at most this many SIFT features per view, 0 = no cap")
       .Min(0);
   registry
-      ->Add(key("contrast_threshold"), &o->contrast_threshold,
-            "SIFT contrast threshold (lower finds more on weak texture)")
-      .Above(0)
-      .Below(1);
-  registry
-      ->Add(key("edge_threshold"), &o->edge_threshold, "SIFT edge threshold")
-      .Above(0);
-  registry
-      ->Add(key("octave_layers"), &o->octave_layers, "SIFT layers per octave")
-      .Min(1)
-      .Max(10);
-  registry->Add(key("sigma"), &o->sigma, "SIFT base blur sigma")
-      .Above(0)
-      .Below(10);
-  registry
       ->Add(key("downscale"), &o->downscale,
             "detect features on the image shrunk by this factor")
       .Min(1)
@@ -66,9 +51,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "limit")
       .Min(64)
       .OrZero();
-  registry->Add(key("srgb_encode"), &o->srgb_encode,
-                "sRGB-encode the grey image before SIFT");
-  registry->Add(key("root_sift"), &o->root_sift, "use RootSIFT descriptors");
 }
 
 size_t Features::bytes() const {
@@ -145,7 +127,7 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
   Require(
       mask.empty() || (mask.type() == CV_8UC1 && mask.size() == image.size()),
       "ExtractFeatures: mask must be CV_8UC1 of the image size");
-  const cv::Mat grey_full = ToGrey8(image, options.srgb_encode);
+  const cv::Mat grey_full = ToGrey8(image, true);
   cv::Mat grey = grey_full;
   cv::Mat det_mask = mask;
   double factor = options.downscale;
@@ -174,9 +156,8 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
 
   // nfeatures = 0: detect all, then keep the strongest ourselves with a
   // deterministic tie-break (position).
-  cv::Ptr<cv::SIFT> sift =
-      cv::SIFT::create(0, options.octave_layers, options.contrast_threshold,
-                       options.edge_threshold, options.sigma, CV_32F);
+  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(
+      0, kOctaveLayers, kContrastThreshold, kEdgeThreshold, kSigma, CV_32F);
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
   sift->detectAndCompute(grey, det_mask, kps, desc);
@@ -222,7 +203,7 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
       const cv::Vec3f& p = image.at<cv::Vec3f>(row, col);
       for (int c = 0; c < 3; ++c) {
         float v = std::min(1.0f, std::max(0.0f, p[c]));
-        if (options.srgb_encode) v = LinearToSrgb(v);
+        v = LinearToSrgb(v);
         rgb(c) = static_cast<uint8_t>(std::lround(v * 255.0f));
       }
     } else {
@@ -230,20 +211,14 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
     }
     f.rgb.push_back(rgb);
 
-    // Normalise (RootSIFT or L2), store as bytes scaled by kDescriptorScale.
+    // RootSIFT (Arandjelovic & Zisserman 2012: L1-normalise, square root),
+    // store as bytes scaled by kDescriptorScale.
     const float* d = desc.ptr<float>(order[i]);
     float v[128];
-    if (options.root_sift) {
-      double l1 = 0;
-      for (int k = 0; k < 128; ++k) l1 += std::abs(d[k]);
-      for (int k = 0; k < 128; ++k)
-        v[k] = l1 > 0 ? static_cast<float>(std::sqrt(std::abs(d[k]) / l1)) : 0;
-    } else {
-      double l2 = 0;
-      for (int k = 0; k < 128; ++k) l2 += static_cast<double>(d[k]) * d[k];
-      const double inv = l2 > 0 ? 1.0 / std::sqrt(l2) : 0;
-      for (int k = 0; k < 128; ++k) v[k] = static_cast<float>(d[k] * inv);
-    }
+    double l1 = 0;
+    for (int k = 0; k < 128; ++k) l1 += std::abs(d[k]);
+    for (int k = 0; k < 128; ++k)
+      v[k] = l1 > 0 ? static_cast<float>(std::sqrt(std::abs(d[k]) / l1)) : 0;
     uint8_t* o = f.descriptors.ptr<uint8_t>(i);
     for (int k = 0; k < 128; ++k) {
       o[k] = static_cast<uint8_t>(

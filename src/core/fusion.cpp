@@ -19,9 +19,6 @@ bool AllFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
 void FusionOptions::Check() const {
   Require(min_support >= 1 && min_support <= 65535,
           "fusion.min_support = ", min_support, " must be in [1, 65535]");
-  Require(std::isfinite(min_confidence) && min_confidence >= 0 &&
-              min_confidence <= 1,
-          "fusion.min_confidence = ", min_confidence, " must be in [0, 1]");
   Require(std::isfinite(depth_tolerance) && depth_tolerance > 0 &&
               depth_tolerance < 1,
           "fusion.depth_tolerance = ", depth_tolerance, " must be in (0, 1)");
@@ -33,10 +30,6 @@ void FusionOptions::Check() const {
               normal_tolerance_deg <= 180,
           "fusion.normal_tolerance_deg = ", normal_tolerance_deg,
           " must be in (0, 180]");
-  Require(std::isfinite(cell_scale) && cell_scale > 0,
-          "fusion.cell_scale = ", cell_scale, " must be > 0");
-  Require(max_neighbors >= 1, "fusion.max_neighbors = ", max_neighbors,
-          " must be >= 1");
   for (int i = 0; i < 3; ++i) {
     Require(!std::isnan(bbox_min[i]) && !std::isnan(bbox_max[i]) &&
                 bbox_min[i] <= bbox_max[i],
@@ -62,11 +55,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(1)
       .Max(65535);
   registry
-      ->Add(key("min_confidence"), &o->min_confidence,
-            "ignore samples with lower confidence")
-      .Min(0)
-      .Max(1);
-  registry
       ->Add(key("depth_tolerance"), &o->depth_tolerance,
             "relative depth tolerance of the consistency check")
       .Above(0)
@@ -80,14 +68,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "largest angle between agreeing normals (degrees)")
       .Above(0)
       .Max(180);
-  registry
-      ->Add(key("cell_scale"), &o->cell_scale,
-            "merge radius as a multiple of the pixel footprint")
-      .Above(0);
-  registry
-      ->Add(key("max_neighbors"), &o->max_neighbors,
-            "related views per view at most")
-      .Min(1);
   const char* const axes[] = {"x", "y", "z"};
   for (int k = 0; k < 3; ++k) {
     registry
@@ -329,7 +309,7 @@ std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::Prepare(
       if (d <= 0) continue;
       const float conf =
           m.confidence.empty() ? 1.f : m.confidence.at<float>(r, c);
-      if (!std::isfinite(conf) || conf < options_.min_confidence) continue;
+      if (!std::isfinite(conf)) continue;
       if (!mask.empty() && mask.at<uint8_t>(r, c) == 0) continue;
       const Eigen::Vector3d Xc = cam_point(c, r, d);
       if (has_box) {
@@ -417,8 +397,8 @@ std::vector<int> StreamingFusion::RelatedViews(int view,
     auto listing = listed_by_.find(view);
     if (listing != listed_by_.end())
       for (int u : listing->second) add(u);
-    if (static_cast<int>(related.size()) > options_.max_neighbors)
-      related.resize(options_.max_neighbors);
+    if (static_cast<int>(related.size()) > kMaxRelatedViews)
+      related.resize(kMaxRelatedViews);
   } else {
     // Overlap: fraction of a grid of v's samples that the other camera sees
     // from a direction within 60 degrees.
@@ -450,7 +430,7 @@ std::vector<int> StreamingFusion::RelatedViews(int view,
     }
     std::sort(scored.begin(), scored.end());
     for (size_t i = 0;
-         i < scored.size() && static_cast<int>(i) < options_.max_neighbors; ++i)
+         i < scored.size() && static_cast<int>(i) < kMaxRelatedViews; ++i)
       related.push_back(scored[i].second);
   }
   // Process in the order the views were added (deterministic).
@@ -489,7 +469,7 @@ void StreamingFusion::Insert(const Sample& s) {
   // Cells of the sample's level are at least `radius` wide; the sample's
   // level and the two adjacent ones are searched (footprints vary across
   // views) in the cells that a ball of the merge radius overlaps.
-  const double radius = options_.cell_scale * s.footprint;
+  const double radius = kCellScale * s.footprint;
   const int level = Level(radius);
   const float w = s.confidence;
   uint32_t best = kNone;

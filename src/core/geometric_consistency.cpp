@@ -10,19 +10,19 @@ namespace wild_mvs {
 
 void GeometricConsistencyOptions::Check() const {
   Require(min_consistent >= 1 && min_consistent <= 32,
-          "mvs.consistency.min_consistent = ", min_consistent,
+          "consistency.min_consistent = ", min_consistent,
           " must be in [1, 32]");
   Require(max_reprojection_px > 0 && max_reprojection_px <= 100,
-          "mvs.consistency.max_reprojection_px = ", max_reprojection_px,
+          "consistency.max_reprojection_px = ", max_reprojection_px,
           " must be in (0, 100]");
   Require(max_relative_depth > 0 && max_relative_depth < 1,
-          "mvs.consistency.max_relative_depth = ", max_relative_depth,
+          "consistency.max_relative_depth = ", max_relative_depth,
           " must be in (0, 1)");
   Require(search_px >= 0 && search_px <= 3,
-          "mvs.consistency.search_px = ", search_px, " must be in [0, 3]");
+          "consistency.search_px = ", search_px, " must be in [0, 3]");
   Require(free_space_margin == -1 ||
               (free_space_margin >= 0 && free_space_margin < 1),
-          "mvs.consistency.free_space_margin = ", free_space_margin,
+          "consistency.free_space_margin = ", free_space_margin,
           " must be -1 (off) or in [0, 1)");
 }
 
@@ -31,9 +31,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   auto key = [&prefix](const char* name) {
     return OptionRegistry::Join(prefix, name);
   };
-  registry->Add(key("enabled"), &o->enabled,
-                "filter each depth map against its neighbours' maps "
-                "(forward-backward reprojection); false = paper");
   registry
       ->Add(key("min_consistent"), &o->min_consistent,
             "neighbour maps that must confirm a sample")
@@ -49,12 +46,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "relative depth difference allowed")
       .Above(0)
       .Below(1);
-  registry
-      ->Add(key("search_px"), &o->search_px,
-            "also try the neighbour's pixels within this many pixels of the "
-            "projection (0 = only the pixel containing it)")
-      .Min(0)
-      .Max(3);
   registry
       ->Add(key("free_space_margin"), &o->free_space_margin,
             "count a neighbour whose depth lies beyond the sample by more "
@@ -148,20 +139,14 @@ cv::Mat CountConsistentViews(const DepthMap& ref,
 void FilterByConsistency(DepthMap* ref,
                          const std::vector<const DepthMap*>& neighbors,
                          const GeometricConsistencyOptions& options,
-                         ConsistencyStats* stats, const cv::Mat& earlier,
-                         int min_consistent_new) {
+                         ConsistencyStats* stats) {
   Require(ref != nullptr, "FilterByConsistency: null map");
-  Require(earlier.empty() ||
-              (earlier.type() == CV_32F && earlier.size() == ref->depth.size()),
-          "FilterByConsistency: the earlier map must be CV_32F of the map's "
-          "size");
-  const int need_new = std::max(options.min_consistent, min_consistent_new);
   ConsistencyStats st;
   st.samples = ref->empty() ? 0 : ref->CountValid();
   st.kept = st.samples;
   bool any = false;
   for (const DepthMap* nb : neighbors) any = any || (nb && !nb->empty());
-  if (options.enabled && any && st.samples > 0) {
+  if (any && st.samples > 0) {
     cv::Mat violations;
     const cv::Mat count =
         CountConsistentViews(*ref, neighbors, options, &violations);
@@ -172,12 +157,9 @@ void FilterByConsistency(DepthMap* ref,
       float* d = ref->depth.ptr<float>(y);
       cv::Vec3f* n = ref->normal.ptr<cv::Vec3f>(y);
       float* f = ref->confidence.ptr<float>(y);
-      const float* e = earlier.empty() ? nullptr : earlier.ptr<float>(y);
       for (int x = 0; x < ref->width(); ++x) {
         if (!(d[x] > 0)) continue;
-        const bool is_new = e && e[x] != d[x];
-        if (c[x] >= (is_new ? need_new : options.min_consistent) &&
-            v[x] <= c[x]) {
+        if (c[x] >= options.min_consistent && v[x] <= c[x]) {
           ++st.kept;
           continue;
         }

@@ -61,22 +61,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "global view selection: neighbourhood size |N| (paper: 10)")
       .Min(1)
       .Max(32);
-  registry
-      ->Add(key("max_parallax_deg"), &o->max_parallax_deg,
-            "parallax weight a_max in degrees (paper: 10)")
-      .Above(0)
-      .Max(90);
-  registry
-      ->Add(key("min_baseline_deg"), &o->min_baseline_deg,
-            "views with a smaller median triangulation angle never enter N "
-            "(twins)")
-      .Min(0)
-      .Below(45);
-  registry
-      ->Add(key("fallback_max_baseline_deg"), &o->fallback_max_baseline_deg,
-            "fallback without shared features: largest triangulation angle")
-      .Max(180)
-      .Note("> min_baseline_deg");
 }
 
 double FeatureScale(const Camera& cam, const Eigen::Vector3d& X) {

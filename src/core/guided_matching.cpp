@@ -19,7 +19,7 @@ std::vector<Match> GuidedMatches(const Camera& ca, const Features& fa,
   if (na == 0 || nb == 0) return out;
   // x_b^T F x_a = 0.
   const Eigen::Matrix3f F = FundamentalMatrix(ca, cb).cast<float>();
-  const float thr = static_cast<float>(opt.max_epipolar_distance);
+  const float thr = static_cast<float>(sparse_internal::kMaxEpipolarDistance);
   std::vector<float> bx(nb), by(nb);
   for (int j = 0; j < nb; ++j) {
     bx[j] = fb.xy[j].x();
@@ -85,9 +85,10 @@ std::vector<Match> GuidedMatches(const Camera& ca, const Features& fa,
       bb.d2 = std::min(bb.d2, c.d);
     }
   }
-  const double max_d = opt.max_descriptor_distance * Features::kDescriptorScale;
+  const double max_d =
+      sparse_internal::kMaxDescriptorDistance * Features::kDescriptorScale;
   const double max_d2 = max_d * max_d;
-  const double r2 = opt.ratio * opt.ratio;
+  const double r2 = sparse_internal::kRatio * sparse_internal::kRatio;
   auto passes = [&](const Best& b) {
     if (b.idx < 0 || b.d1 > max_d2) return false;
     return b.d2 == kInf || static_cast<double>(b.d1) < r2 * b.d2;
@@ -95,7 +96,7 @@ std::vector<Match> GuidedMatches(const Camera& ca, const Features& fa,
   for (int i = 0; i < na; ++i) {
     const int j = best_a[i].idx;
     if (!passes(best_a[i])) continue;
-    if (opt.mutual && (best_b[j].idx != i || !passes(best_b[j]))) continue;
+    if ((best_b[j].idx != i || !passes(best_b[j]))) continue;
     out.emplace_back(i, j);
   }
   return out;

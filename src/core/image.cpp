@@ -17,9 +17,6 @@ void ImageOptions::Check() const {
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      ImageOptions* o) {
-  registry->Add(OptionRegistry::Join(prefix, "linearize"), &o->linearize,
-                "apply the inverse sRGB curve at load (match in linear "
-                "radiance)");
   registry
       ->Add(OptionRegistry::Join(prefix, "cache_mb"), &o->cache_mb,
             "image cache budget in MB (least recently used images evicted)")

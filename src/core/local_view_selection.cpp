@@ -12,9 +12,6 @@ namespace wild_mvs {
 void LocalViewSelectionOptions::Check() const {
   Require(num_active >= 1 && num_active <= 8,
           "mvs.local.num_active = ", num_active, " must be in [1, 8]");
-  Require(max_epipolar_angle_deg > 0 && max_epipolar_angle_deg <= 90,
-          "mvs.local.max_epipolar_angle_deg = ", max_epipolar_angle_deg,
-          " must be in (0, 90]");
   Require(min_ncc >= -1 && min_ncc <= 1, "mvs.local.min_ncc = ", min_ncc,
           " must be in [-1, 1]");
   Require(wide_min_ncc >= -2 && wide_min_ncc <= 1,
@@ -27,20 +24,12 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   auto key = [&prefix](const char* name) {
     return OptionRegistry::Join(prefix, name);
   };
-  registry->Add(key("enabled"), &o->enabled,
-                "local view selection per pixel; false = fixed best views "
-                "(ablation)");
   registry
       ->Add(key("num_active"), &o->num_active,
             "active views per pixel |A| (paper: 4)")
       .Min(1)
       .Max(8)
       .Note(">= mpgc.min_active_views");
-  registry
-      ->Add(key("max_epipolar_angle_deg"), &o->max_epipolar_angle_deg,
-            "epipolar-angle spread g_max in degrees (paper: 10)")
-      .Above(0)
-      .Max(90);
   registry
       ->Add(key("min_ncc"), &o->min_ncc,
             "NCC needed to enter the active set (paper: 0.3)")

@@ -16,20 +16,22 @@
 
 namespace wild_mvs {
 
+namespace {
+// Screened Poisson (Kazhdan and Hoppe 2013): PoissonRecon's screening
+// weight, samples per octree node for MVS noise, and the reconstruction
+// cube over the samples' bounding cube.
+constexpr double kPointWeight = 4.0;
+constexpr double kSamplesPerNode = 1.5;
+constexpr double kScale = 1.1;
+// Neighbours whose mean distance defines the local sample spacing (trim).
+constexpr int kSpacingNeighbors = 8;
+}  // namespace
+
 void MeshingOptions::Check() const {
   Require(depth >= 4 && depth <= 14, "meshing.depth = ", depth,
           " must be in [4, 14]");
-  Require(std::isfinite(point_weight) && point_weight >= 0,
-          "meshing.point_weight = ", point_weight, " must be >= 0");
-  Require(std::isfinite(samples_per_node) && samples_per_node >= 1,
-          "meshing.samples_per_node = ", samples_per_node, " must be >= 1");
-  Require(std::isfinite(scale) && scale >= 1 && scale <= 4,
-          "meshing.scale = ", scale, " must be in [1, 4]");
   Require(std::isfinite(trim_distance) && trim_distance >= 0,
           "meshing.trim_distance = ", trim_distance, " must be >= 0");
-  Require(spacing_neighbors >= 1 && spacing_neighbors <= 64,
-          "meshing.spacing_neighbors = ", spacing_neighbors,
-          " must be in [1, 64]");
   Require(min_component_faces >= 0,
           "meshing.min_component_faces = ", min_component_faces,
           " must be >= 0");
@@ -50,28 +52,10 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(4)
       .Max(14);
   registry
-      ->Add(key("point_weight"), &o->point_weight,
-            "screening weight of the points, 0 = unscreened Poisson")
-      .Min(0);
-  registry
-      ->Add(key("samples_per_node"), &o->samples_per_node,
-            "minimum samples per octree node (more for noisy data)")
-      .Min(1);
-  registry
-      ->Add(key("scale"), &o->scale,
-            "reconstruction cube / bounding cube of the samples")
-      .Min(1)
-      .Max(4);
-  registry
       ->Add(key("trim_distance"), &o->trim_distance,
             "remove surface farther than this x local sample spacing from "
             "the samples, 0 = no trimming")
       .Min(0);
-  registry
-      ->Add(key("spacing_neighbors"), &o->spacing_neighbors,
-            "neighbours defining the local sample spacing")
-      .Min(1)
-      .Max(64);
   registry
       ->Add(key("min_component_faces"), &o->min_component_faces,
             "drop connected pieces with fewer faces after trimming")
@@ -194,13 +178,13 @@ Mesh MeshPointCloud(const PointCloud& cloud, const MeshingOptions& options,
     hi = hi.cwiseMax(p);
   }
   stats.voxel_size =
-      (hi - lo).maxCoeff() * options.scale / std::ldexp(1.0, options.depth);
+      (hi - lo).maxCoeff() * kScale / std::ldexp(1.0, options.depth);
 
   pcl::Poisson<pcl::PointNormal> poisson;
   poisson.setDepth(options.depth);
-  poisson.setPointWeight(static_cast<float>(options.point_weight));
-  poisson.setSamplesPerNode(static_cast<float>(options.samples_per_node));
-  poisson.setScale(static_cast<float>(options.scale));
+  poisson.setPointWeight(static_cast<float>(kPointWeight));
+  poisson.setSamplesPerNode(static_cast<float>(kSamplesPerNode));
+  poisson.setScale(static_cast<float>(kScale));
   poisson.setThreads(options.threads);
   poisson.setManifold(true);
   poisson.setOutputPolygons(false);
@@ -228,8 +212,8 @@ Mesh MeshPointCloud(const PointCloud& cloud, const MeshingOptions& options,
   // Nearest sample of every vertex, local spacing of every sample.
   pcl::KdTreeFLANN<pcl::PointNormal> tree;
   tree.setInputCloud(pts);
-  const int k = std::min<int>(options.spacing_neighbors + 1,
-                              static_cast<int>(cloud.size()));
+  const int k =
+      std::min<int>(kSpacingNeighbors + 1, static_cast<int>(cloud.size()));
   std::vector<float> spacing(cloud.size(), 0.f);
   {
     std::vector<int> idx(k);

@@ -10,19 +10,6 @@
 #include "wild_mvs/core/ncc.h"
 
 namespace wild_mvs {
-namespace {
-
-// d(linear) / d(sRGB-encoded value) at linear intensity v: converts a spread
-// of linear intensities into one of encoded levels (where a camera's 8-bit
-// quantisation and noise are roughly uniform).
-double LinearPerSrgb(double v) {
-  v = std::clamp(v, 0.0, 1.0);
-  if (v <= 0.0031308) return 1.0 / 12.92;
-  // linear = ((s + 0.055) / 1.055)^2.4 -> d/ds = 2.4 / 1.055 * linear^(1.4/2.4)
-  return 2.4 / 1.055 * std::pow(v, 1.4 / 2.4);
-}
-
-}  // namespace
 
 int AutoWindowStep(int step, int width, int height) {
   if (step > 0) return step;
@@ -43,44 +30,17 @@ void MpgcOptions::Check() const {
   Require(window_step >= 0 && window_step <= 4,
           "mvs.mpgc.window_step = ", window_step,
           " must be in [0, 4] (0 = by image size)");
-  Require(settle_iterations >= 0,
-          "mvs.mpgc.settle_iterations = ", settle_iterations, " must be >= 0");
   Require(drop_ncc >= -1 && drop_ncc <= 1, "mvs.mpgc.drop_ncc = ", drop_ncc,
           " must be in [-1, 1]");
   Require(wide_drop_ncc >= -2 && wide_drop_ncc <= 1,
           "mvs.mpgc.wide_drop_ncc = ", wide_drop_ncc,
           " must be in [-2, 1] (< -1 = drop_ncc)");
-  Require(convergence_eps > 0, "mvs.mpgc.convergence_eps = ", convergence_eps,
-          " must be > 0");
-  Require(max_iterations > settle_iterations,
-          "mvs.mpgc.max_iterations = ", max_iterations,
-          " must exceed mvs.mpgc.settle_iterations = ", settle_iterations);
-  Require(full_update_interval >= 1,
-          "mvs.mpgc.full_update_interval = ", full_update_interval,
-          " must be >= 1");
-  Require(oscillation_iteration >= 0,
-          "mvs.mpgc.oscillation_iteration = ", oscillation_iteration,
-          " must be >= 0");
-  Require(min_facing >= 0 && min_facing < 1,
-          "mvs.mpgc.min_facing = ", min_facing, " must be in [0, 1)");
-  Require(accept_ncc >= -1 && accept_ncc <= 1,
-          "mvs.mpgc.accept_ncc = ", accept_ncc, " must be in [-1, 1]");
   Require(explain_margin == -1 || (explain_margin >= 0 && explain_margin <= 2),
           "mvs.mpgc.explain_margin = ", explain_margin,
           " must be -1 (off) or in [0, 2]");
   Require(explain_below_ncc >= -1 && explain_below_ncc <= 1.5,
           "mvs.mpgc.explain_below_ncc = ", explain_below_ncc,
           " must be in [-1, 1.5]");
-  Require(min_texture_levels >= 0 && min_texture_levels <= 64,
-          "mvs.mpgc.min_texture_levels = ", min_texture_levels,
-          " must be in [0, 64]");
-  Require(normal_step_halvings >= 0 && normal_step_halvings <= 8,
-          "mvs.mpgc.normal_step_halvings = ", normal_step_halvings,
-          " must be in [0, 8]");
-  Require(forecast_iteration >= -1 && forecast_iteration < settle_iterations,
-          "mvs.mpgc.forecast_iteration = ", forecast_iteration,
-          " must be -1 (off) or in [0, mvs.mpgc.settle_iterations = ",
-          settle_iterations, ")");
   Require(std::isfinite(bilateral_sigma_color) && bilateral_sigma_color >= 0,
           "mvs.mpgc.bilateral_sigma_color = ", bilateral_sigma_color,
           " must be >= 0 (0 = off)");
@@ -91,17 +51,15 @@ void MpgcOptions::Check() const {
               bilateral_min_weight <= 1,
           "mvs.mpgc.bilateral_min_weight = ", bilateral_min_weight,
           " must be in [0, 1]");
-  Require(std::isfinite(forecast_margin) && forecast_margin >= 0 &&
-              forecast_margin <= 2,
-          "mvs.mpgc.forecast_margin = ", forecast_margin, " must be in [0, 2]");
   Require(min_active_views >= 1 && min_active_views <= kMaxActive,
           "mvs.mpgc.min_active_views = ", min_active_views, " must be in [1, ",
           kMaxActive, "]");
 }
 
 PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
-                           const LocalViewSelectionOptions& local)
-    : ctx_(context), mpgc_(mpgc), local_(local) {
+                           const LocalViewSelectionOptions& local,
+                           const MpgcSchedule& schedule)
+    : ctx_(context), mpgc_(mpgc), local_(local), schedule_(schedule) {
   mpgc_.Check();
   local_.Check();
   Require(mpgc_.window == ctx_.window, "PatchMatcher: window ", mpgc_.window,
@@ -124,7 +82,7 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
             channels_, " channels");
   Require(ctx_.views.size() <= static_cast<size_t>(kMaxNeighbors),
           "PatchMatcher: too many neighbours");
-  max_angle_rad_ = local_.max_epipolar_angle_deg * M_PI / 180.0;
+  max_angle_rad_ = kMaxEpipolarAngleDeg * M_PI / 180.0;
   for (size_t v = 0; v < ctx_.views.size(); ++v) {
     global_scores_[v] = ctx_.views[v].global_score;
     by_global_score_[v] = static_cast<int>(v);
@@ -236,7 +194,7 @@ double PatchMatcher::SlotNcc(int slot_index) const {
 void PatchMatcher::InitScales(int slot_index) {
   SlotData& sl = slots_[slot_index];
   for (int c = 0; c < 3; ++c) sl.scale[c] = 1.0f;
-  if (!mpgc_.optimize_color_scale) return;
+  if (!ctx_.ablation.optimize_color_scale) return;
   for (int c = 0; c < channels_; ++c) {
     double sv = 0, svv = 0;  // weighted (weight_)
     for (int i = 0; i < npix_; ++i) {
@@ -244,7 +202,7 @@ void PatchMatcher::InitScales(int slot_index) {
       sv += weight_[i] * p;
       svv += weight_[i] * p * p;
     }
-    if (mpgc_.photometric_offset) {
+    if (ctx_.ablation.photometric_offset) {
       // Contrast ratio of the mean-free windows.
       const double saa = ref_saa_c_[c];
       const double sbb = svv - sv * sv / weight_sum_;
@@ -271,8 +229,8 @@ int PatchMatcher::FillActive() {
   const int nv = static_cast<int>(ctx_.views.size());
   int slot = -1;
   return FillActiveSet(
-      local_, nv, global_scores_, epi_dir_, max_angle_rad_, state_, active_,
-      &num_active_,
+      local_, ctx_.ablation.local_view_selection, nv, global_scores_, epi_dir_,
+      max_angle_rad_, state_, active_, &num_active_,
       [&](int v, double* ncc) {
         slot = FreeSlot();
         PrepareView(v, slot);
@@ -330,7 +288,6 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
       }
     }
   }
-  double levels = 0;  // spread in 8-bit sRGB levels, summed over channels
   for (int c = 0; c < channels_; ++c) {
     const double mean = ref_sum_[c] / npix_;
     double var_c = 0;
@@ -339,12 +296,9 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
       var_c += d * d;
     }
     var_total += var_c;
-    if (mpgc_.min_texture_levels > 0)
-      levels += std::sqrt(var_c / npix_) * 255.0 / LinearPerSrgb(mean);
   }
   // A textureless reference window cannot be matched (NCC undefined).
   if (var_total < kNccMinVariance * npix_ * channels_ * 100) return false;
-  if (levels < mpgc_.min_texture_levels * channels_) return false;
   if (mpgc_.bilateral_sigma_color > 0) SetBilateralWeights();
   for (int c = 0; c < channels_; ++c) {
     double sum = 0;
@@ -363,7 +317,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
     ref_saa_ += saa_c;
   }
   Eigen::Vector3d n = normal;
-  if (!mpgc_.optimize_normal || !(n.norm() > 0.5))
+  if (!ctx_.ablation.optimize_normal || !(n.norm() > 0.5))
     n = Eigen::Vector3d(0, 0, -1);
   h_ = PlaneToPatch(cam, s, t, depth, n.normalized(), &hs_, &ht_);
   if (!std::isfinite(h_) || h_ <= 0) return false;
@@ -371,7 +325,8 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   const int nv = static_cast<int>(ctx_.views.size());
   for (int k = 0; k < nv; ++k) {
     epi_dir_[k] = EpipolarDirection(ctx_.views[k].epipole, u, v);
-    state_[k] = (!local_.enabled && k >= local_.num_active) ? 2 : 0;
+    state_[k] =
+        (!ctx_.ablation.local_view_selection && k >= local_.num_active) ? 2 : 0;
   }
   num_active_ = 0;
   for (SlotData& sl : slots_) sl.fresh = false;
@@ -457,9 +412,9 @@ int PatchMatcher::SampleActive(int first) {
 }
 
 int PatchMatcher::TestActive(int it, bool* stable) {
-  const bool baseline = it == mpgc_.settle_iterations;
-  const bool oscillation_check =
-      mpgc_.oscillation_iteration > 0 && it == mpgc_.oscillation_iteration;
+  const bool baseline = it == schedule_.settle_iterations;
+  const bool oscillation_check = schedule_.oscillation_iteration > 0 &&
+                                 it == schedule_.oscillation_iteration;
   int dropped = 0;
   *stable = !baseline;
   for (int a = 0; a < num_active_;) {
@@ -467,7 +422,7 @@ int PatchMatcher::TestActive(int it, bool* stable) {
     sl.prev_ncc = baseline ? std::numeric_limits<double>::quiet_NaN() : sl.ncc;
     sl.ncc = SlotNcc(active_slot_[a]);
     const bool moved = !(std::abs(sl.ncc - sl.prev_ncc) <=
-                         mpgc_.convergence_eps);  // NaN (new view) = moved
+                         schedule_.convergence_eps);  // NaN (new view) = moved
     if (baseline) Note(it, MatchTrace::Kind::kBaseline, active_[a]);
     MatchTrace::Kind why = MatchTrace::Kind::kConverged;  // = kept
     if (sl.ncc < mpgc_.drop_ncc) {
@@ -487,23 +442,6 @@ int PatchMatcher::TestActive(int it, bool* stable) {
   return dropped;
 }
 
-bool PatchMatcher::SettlingHopeless() {
-  int can_pass = 0;
-  const double bar = mpgc_.drop_ncc - mpgc_.forecast_margin;
-  for (int a = 0; a < num_active_; ++a)
-    can_pass += SlotNcc(active_slot_[a]) >= bar;
-  // The views not tried yet, until enough pass (a free slot; the state of
-  // the match is not changed).
-  const int nv = static_cast<int>(ctx_.views.size());
-  const int slot = FreeSlot();
-  for (int k = 0; k < nv && can_pass < mpgc_.min_active_views; ++k) {
-    if (state_[k] != 0) continue;
-    PrepareView(k, slot);
-    can_pass += SampleSlot(slot, false) && SlotNcc(slot) >= bar;
-  }
-  return can_pass < mpgc_.min_active_views;
-}
-
 int PatchMatcher::RefillActive() {
   const int first_new = num_active_;
   FillActive();
@@ -519,7 +457,7 @@ bool PatchMatcher::DepthStep() {
     const SlotData& sl = slots_[active_slot_[a]];
     mpgc_kernels::ChannelSums cs[4];
     mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
-                             npix_, mpgc_.photometric_offset,
+                             npix_, ctx_.ablation.photometric_offset,
                              /*depth_only=*/true, cs);
     for (int c = 0; c < channels_; ++c) {
       q2 += cs[c].h[0];
@@ -548,7 +486,7 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
     // its window mean (the kernel's `center`).
     mpgc_kernels::ChannelSums cs[4];
     mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
-                             npix_, mpgc_.photometric_offset,
+                             npix_, ctx_.ablation.photometric_offset,
                              /*depth_only=*/false, cs);
     for (int c = 0; c < channels_; ++c) {
       const double* h = cs[c].h;
@@ -602,20 +540,8 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
   h_ += d.x();
   if (!(h_ > 0) || !std::isfinite(h_)) return false;
   if (fit_normal) {
-    // Step control: never step the normal past facing the camera.
-    double ds = d.y(), dt = d.z();
-    const Camera& cam = ctx_.ref_camera;
-    const Eigen::Vector3d ray = RayAt(cam, s_ + 0.5, t_ + 0.5);
-    for (int k = 0; k < mpgc_.normal_step_halvings; ++k) {
-      if (PatchNormal(cam, s_, t_, h_, hs_ + ds, ht_ + dt).dot(-ray) >
-          mpgc_.min_facing)
-        break;
-      ds *= 0.5;
-      dt *= 0.5;
-      if (k + 1 == mpgc_.normal_step_halvings) ds = dt = 0;
-    }
-    hs_ += ds;
-    ht_ += dt;
+    hs_ += d.y();
+    ht_ += d.z();
   }
   return true;
 }
@@ -624,11 +550,10 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   const Camera& cam = ctx_.ref_camera;
   const Eigen::Vector3d ray = RayAt(cam, s_ + 0.5, t_ + 0.5);
   const Eigen::Vector3d n = PatchNormal(cam, s_, t_, h_, hs_, ht_);
-  if (!(n.dot(-ray) > mpgc_.min_facing)) return false;
+  if (!(n.dot(-ray) > kMinFacing)) return false;
   double sum = 0;
   for (int a = 0; a < num_active_; ++a) sum += slots_[active_slot_[a]].ncc;
   const double mean_ncc = sum / num_active_;
-  if (mean_ncc < mpgc_.accept_ncc) return false;
   double pair_ncc = std::numeric_limits<double>::quiet_NaN();
   bool explained = true;
   if (mpgc_.explain_margin >= 0 && num_active_ >= 2 &&
@@ -646,7 +571,7 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   out->pair_ncc = pair_ncc;
   out->explained = explained;
   out->depth = h_ * ray.z();
-  out->normal = mpgc_.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);
+  out->normal = ctx_.ablation.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);
   out->confidence = std::clamp((mean_ncc + 1.0) * 0.5, 0.0, 1.0);
   out->iterations = iterations;
   out->num_active = num_active_;
@@ -727,11 +652,7 @@ bool PatchMatcher::Match(int s, int t, double depth,
     const int left = SampleActive(0);
     int dropped = 0;
     bool stable = false;
-    if (it >= mpgc_.settle_iterations) dropped = TestActive(it, &stable);
-    if (it == mpgc_.forecast_iteration && SettlingHopeless()) {
-      Note(it, MatchTrace::Kind::kForecastFailed, -1);
-      return false;
-    }
+    if (it >= schedule_.settle_iterations) dropped = TestActive(it, &stable);
     if (left + dropped == 0 && stable && !changed &&
         num_active_ >= mpgc_.min_active_views) {
       Note(it, MatchTrace::Kind::kConverged, -1);
@@ -741,13 +662,14 @@ bool PatchMatcher::Match(int s, int t, double depth,
       changed = true;
       RefillActive();
     }
-    if (num_active_ < mpgc_.min_active_views || it == mpgc_.max_iterations) {
+    if (num_active_ < mpgc_.min_active_views ||
+        it == schedule_.max_iterations) {
       Note(it, MatchTrace::Kind::kFailed, -1);
       return false;
     }
-    const bool full = changed || (it + 1) % mpgc_.full_update_interval == 0;
-    const bool fit_normal = full && mpgc_.optimize_normal;
-    const bool fit_scale = full && mpgc_.optimize_color_scale;
+    const bool full = changed || (it + 1) % schedule_.full_update_interval == 0;
+    const bool fit_normal = full && ctx_.ablation.optimize_normal;
+    const bool fit_scale = full && ctx_.ablation.optimize_color_scale;
     Note(it,
          (fit_normal || fit_scale) ? MatchTrace::Kind::kFullUpdate
                                    : MatchTrace::Kind::kDepthUpdate,
@@ -793,10 +715,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(0)
       .Max(4);
   registry
-      ->Add(key("settle_iterations"), &o->settle_iterations,
-            "iterations before any test (paper: 5)")
-      .Min(0);
-  registry
       ->Add(key("drop_ncc"), &o->drop_ncc,
             "drop active views whose NCC falls below (paper: 0.4)")
       .Min(-1)
@@ -808,40 +726,11 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(-2)
       .Max(1);
   registry
-      ->Add(key("convergence_eps"), &o->convergence_eps,
-            "converged when every NCC changes less (paper: 0.001)")
-      .Above(0);
-  registry
-      ->Add(key("max_iterations"), &o->max_iterations,
-            "fail after this many iterations (paper: 20)")
-      .Note("> settle_iterations");
-  registry
-      ->Add(key("full_update_interval"), &o->full_update_interval,
-            "optimise normal and colour scales every k-th iteration "
-            "(paper: 5)")
-      .Min(1);
-  registry
-      ->Add(key("oscillation_iteration"), &o->oscillation_iteration,
-            "once, after this iteration, drop views whose NCC still moves "
-            "(paper: 14); 0 = never")
-      .Min(0);
-  registry
-      ->Add(key("min_facing"), &o->min_facing,
-            "normal . (-ray) must exceed this (paper: 0.1)")
-      .Min(0)
-      .Below(1);
-  registry
       ->Add(key("min_active_views"), &o->min_active_views,
             "fail when fewer active views remain")
       .Min(1)
       .Max(kMaxActive)
       .Note("<= local.num_active");
-  registry
-      ->Add(key("accept_ncc"), &o->accept_ncc,
-            "accept a match only when its mean NCC reaches this; -1 = any "
-            "(paper)")
-      .Min(-1)
-      .Max(1);
   registry
       ->Add(key("explain_margin"), &o->explain_margin,
             "fail a match whose best view's NCC with R is more than this "
@@ -859,12 +748,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                 "an unexplained match keeps its depth but region growing "
                 "does not expand from it (false = it fails)");
   registry
-      ->Add(key("min_texture_levels"), &o->min_texture_levels,
-            "do not match reference windows whose spread is below this many "
-            "8-bit sRGB levels; 0 = off (paper)")
-      .Min(0)
-      .Max(64);
-  registry
       ->Add(key("bilateral_sigma_color"), &o->bilateral_sigma_color,
             "weight window samples by their colour difference from the "
             "centre (sigma in 8-bit gamma-2 levels) and distance; 0 = off "
@@ -881,30 +764,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "sigma_color")
       .Min(0)
       .Max(1);
-  registry
-      ->Add(key("normal_step_halvings"), &o->normal_step_halvings,
-            "halve a normal step that turns the patch away up to this many "
-            "times; 0 = off (paper)")
-      .Min(0)
-      .Max(8);
-  registry->Add(key("photometric_offset"), &o->photometric_offset,
-                "photometric model I_R = c I_V + b (an offset per view and "
-                "channel); false = c I_V (paper)");
-  registry
-      ->Add(key("forecast_iteration"), &o->forecast_iteration,
-            "after this many updates fail a pixel whose views cannot pass "
-            "kappa at settling; -1 = off (paper)")
-      .Min(-1)
-      .Note("< settle_iterations");
-  registry
-      ->Add(key("forecast_margin"), &o->forecast_margin,
-            "NCC below kappa still counted as passing by forecast_iteration")
-      .Min(0)
-      .Max(2);
-  registry->Add(key("optimize_normal"), &o->optimize_normal,
-                "optimise the normal; false = fronto-parallel (ablation)");
-  registry->Add(key("optimize_color_scale"), &o->optimize_color_scale,
-                "optimise per-view colour scales; false = fixed 1 (lab data)");
 }
 
 }  // namespace wild_mvs

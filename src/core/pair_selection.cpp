@@ -11,6 +11,8 @@
 namespace wild_mvs {
 
 using sparse_internal::kDeg;
+using sparse_internal::kMaxPairAngleDeg;
+using sparse_internal::kMinOverlap;
 
 // Typical depth of the scene seen by `cam` (0 = unknown).
 double SparseTracker::Impl::EstimateDepth(const Camera& cam) const {
@@ -47,7 +49,7 @@ std::vector<int> SparseTracker::Impl::SelectNeighbors(const Camera& cam) const {
     const double axis_angle = std::acos(std::min(
         1.0,
         std::max(-1.0, cam.ViewDirection().dot(v.camera.ViewDirection()))));
-    if (axis_angle > opt.max_pair_angle_deg * kDeg) continue;
+    if (axis_angle > kMaxPairAngleDeg * kDeg) continue;
     const double b = (v.camera.Center() - c).norm();
     if (!(b > 0)) continue;
     double score = 0;
@@ -56,7 +58,7 @@ std::vector<int> SparseTracker::Impl::SelectNeighbors(const Camera& cam) const {
           FrustumGridOverlap(cam, v.camera,
                              {0.5 * depth, std::sqrt(0.5) * depth, depth,
                               std::sqrt(2.0) * depth, 2 * depth});
-      if (overlap < opt.min_overlap) continue;
+      if (overlap < kMinOverlap) continue;
       const Eigen::Vector3d X = cam.Backproject(
           Eigen::Vector2d(0.5 * cam.width, 0.5 * cam.height), depth);
       const double angle = TriangulationAngle(c, v.camera.Center(), X);
@@ -71,7 +73,7 @@ std::vector<int> SparseTracker::Impl::SelectNeighbors(const Camera& cam) const {
       std::vector<double> depths;
       for (double d = b; d <= far * 1.0001; d *= 2) depths.push_back(d);
       score = FrustumGridOverlap(cam, v.camera, depths);
-      if (score < opt.min_overlap) continue;
+      if (score < kMinOverlap) continue;
     }
     scored.emplace_back(-score, static_cast<int>(s));
   }

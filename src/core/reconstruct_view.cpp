@@ -15,13 +15,11 @@ namespace wild_mvs {
 
 void MvsOptions::Check() const {
   global.Check();
-  rescaling.Check();
   local.Check();
   mpgc.Check();
   growing.Check();
   sweep.Check();
   consistency.Check();
-  refine.Check();
   Require(max_image_size >= 0, "mvs.max_image_size = ", max_image_size,
           " must be >= 0 (0 = no limit)");
   Require(mpgc.min_active_views <= local.num_active,
@@ -31,29 +29,18 @@ void MvsOptions::Check() const {
 
 MvsOptions PaperMvsOptions() {
   MvsOptions o;
-  o.mpgc.accept_ncc = -1;
   o.mpgc.explain_margin = -1;
   o.mpgc.explain_below_ncc = 1.1;
   o.mpgc.explain_keeps_match = false;
-  o.mpgc.min_texture_levels = 0;
-  o.mpgc.normal_step_halvings = 0;
-  o.mpgc.forecast_iteration = -1;
-  o.mpgc.photometric_offset = false;
   o.mpgc.bilateral_sigma_color = 0;
   o.mpgc.wide_drop_ncc = -2;
   o.local.wide_min_ncc = -2;
   o.mpgc.window = 5;
   o.mpgc.window_step = 1;
   o.growing.revisit_margin = 0;
-  o.growing.hypotheses = 0;
-  o.growing.start_views = 0;
-  o.growing.start_min_score = -1;
-  o.growing.expand_min_ncc = -1;
   o.sweep.below_seeds = 0;
-  o.consistency.enabled = false;
-  o.consistency.search_px = 0;
-  o.consistency.free_space_margin = -1;
-  o.refine.enabled = false;
+  o.ablation.photometric_offset = false;
+  o.ablation.consistency = false;
   return o;
 }
 
@@ -92,14 +79,13 @@ OwnedImage MakeMatchImage(std::shared_ptr<const cv::Mat> img, bool color) {
   return o;
 }
 
-// ReconstructView (start null) and RefineView (start: the first pass's
-// filtered map, neighbors: the neighbours' filtered maps).
-DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
-                 const MvsOptions& options, ThreadPool* pool,
-                 ViewReport* report, const cv::Mat& mask,
-                 const std::vector<std::vector<int>>* points_per_view,
-                 const std::atomic<bool>* cancel, const DepthMap* start,
-                 const std::vector<const DepthMap*>* neighbors) {
+}  // namespace
+
+DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
+                         const MvsOptions& options, ThreadPool* pool,
+                         ViewReport* report, const cv::Mat& mask,
+                         const std::vector<std::vector<int>>* points_per_view,
+                         const std::atomic<bool>* cancel) {
   const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = ThreadCpuSeconds();
   double body_cpu = 0;
@@ -139,8 +125,8 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
   for (int v : sel.neighbors)
     rep.scales.push_back(ScaleRatio(scene, ref, v, ppv, &axis_point));
   const RescalingPlan plan =
-      PlanRescaling(scene, ref, sel.neighbors, rep.scales, options.rescaling,
-                    options.max_image_size);
+      PlanRescaling(scene, ref, sel.neighbors, rep.scales,
+                    options.ablation.rescaling, options.max_image_size);
   const Camera& cam = plan.ref_camera;
   rep.working_scale = static_cast<double>(cam.width) / cam_full.width;
   rep.width = cam.width;
@@ -153,19 +139,6 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
   dm.depth = cv::Mat::zeros(cam.height, cam.width, CV_32F);
   dm.normal = cv::Mat::zeros(cam.height, cam.width, CV_32FC3);
   dm.confidence = cv::Mat::zeros(cam.height, cam.width, CV_32F);
-  if (start) {
-    Require(start->width() == cam.width && start->height() == cam.height &&
-                start->normal.size() == start->depth.size() &&
-                start->confidence.size() == start->depth.size(),
-            "RefineView: the map of view '", scene.views[ref].name, "' is ",
-            start->width(), "x", start->height(),
-            " but its working resolution is ", cam.width, "x", cam.height,
-            " (computed with other options?)");
-    start->depth.copyTo(dm.depth);
-    start->normal.copyTo(dm.normal);
-    start->confidence.copyTo(dm.confidence);
-    rep.start_samples = dm.CountValid();
-  }
 
   if (sel.neighbors.empty()) {
     rep.fallbacks.push_back(
@@ -175,18 +148,19 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
   } else {
     // Images at their working resolutions.
     const OwnedImage ref_img = MakeMatchImage(
-        images.GetResized(ref, cam.width, cam.height), options.use_color);
+        images.GetResized(ref, cam.width, cam.height), options.ablation.color);
     std::vector<OwnedImage> nb_img;
     nb_img.reserve(sel.neighbors.size());
     PatchContext ctx;
     ctx.ref_camera = cam;
     ctx.ref_image = ref_img.view;
     ctx.window = options.mpgc.window;
+    ctx.ablation = options.ablation;
     for (size_t i = 0; i < sel.neighbors.size(); ++i) {
       const Camera& nc = plan.neighbor_cameras[i];
       nb_img.push_back(MakeMatchImage(
           images.GetResized(sel.neighbors[i], nc.width, nc.height),
-          options.use_color));
+          options.ablation.color));
       ctx.AddView(sel.neighbors[i], nc, nb_img.back().view,
                   sel.scores[i] > 0 ? sel.scores[i] : 1e-6);
     }
@@ -213,16 +187,9 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
       if (x < 0 || y < 0 || x >= cam.width || y >= cam.height) return;
       seeds.push_back(Seed{x, y, cam.Depth(X)});
     };
-    if (start) {
-      // The second pass: seeds from the filtered maps instead.
-      seeds = RefinementSeeds(*start, *neighbors, wmask, options.refine,
-                              &rep.refine_seeds);
-    } else {
-      for (int p : ppv[ref]) add_point(p);
-      if (options.growing.seeds_from_neighbors)
-        for (int v : sel.neighbors)
-          for (int p : ppv[v]) add_point(p);
-    }
+    for (int p : ppv[ref]) add_point(p);
+    for (int v : sel.neighbors)
+      for (int p : ppv[v]) add_point(p);
 
     // The matching thresholds for this working size (wide windows).
     MpgcOptions mpgc = options.mpgc;
@@ -232,8 +199,8 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
     if (!seeds.empty())
       GrowRegions(ctx, mpgc, local, options.growing, seeds, wmask, pool,
                   &dm.depth, &dm.normal, &dm.confidence, &stats, cancel);
-    if (!start && (stats.seeds_accepted == 0 ||
-                   stats.seeds_accepted < options.sweep.below_seeds)) {
+    if (stats.seeds_accepted == 0 ||
+        stats.seeds_accepted < options.sweep.below_seeds) {
       // No (or too few) sparse features produced a match: seed the pixels
       // still empty from a plane sweep.
       double lo = dmin, hi = dmax;
@@ -281,48 +248,21 @@ DepthMap RunView(const Scene& scene, int ref, ImageCache& images,
   return dm;
 }
 
-}  // namespace
-
-DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
-                         const MvsOptions& options, ThreadPool* pool,
-                         ViewReport* report, const cv::Mat& mask,
-                         const std::vector<std::vector<int>>* points_per_view,
-                         const std::atomic<bool>* cancel) {
-  return RunView(scene, ref, images, options, pool, report, mask,
-                 points_per_view, cancel, nullptr, nullptr);
-}
-
-DepthMap RefineView(const Scene& scene, int ref, ImageCache& images,
-                    const MvsOptions& options, const DepthMap& start,
-                    const std::vector<const DepthMap*>& neighbors,
-                    ThreadPool* pool, ViewReport* report, const cv::Mat& mask,
-                    const std::vector<std::vector<int>>* points_per_view,
-                    const std::atomic<bool>* cancel) {
-  Require(!start.empty(), "RefineView: empty map of view ", ref);
-  return RunView(scene, ref, images, options, pool, report, mask,
-                 points_per_view, cancel, &start, &neighbors);
-}
-
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      MvsOptions* o) {
   auto key = [&prefix](const char* name) {
     return OptionRegistry::Join(prefix, name);
   };
-  registry->Add(key("use_color"), &o->use_color,
-                "match colour images; false = grey (ablation)");
   registry
       ->Add(key("max_image_size"), &o->max_image_size,
             "longest side of the reference view's working image, 0 = any "
             "(after image.max_image_size)")
       .Min(0);
   RegisterOptions(registry, key("global"), &o->global);
-  RegisterOptions(registry, key("rescaling"), &o->rescaling);
   RegisterOptions(registry, key("local"), &o->local);
   RegisterOptions(registry, key("mpgc"), &o->mpgc);
   RegisterOptions(registry, key("growing"), &o->growing);
   RegisterOptions(registry, key("sweep"), &o->sweep);
-  RegisterOptions(registry, key("consistency"), &o->consistency);
-  RegisterOptions(registry, key("refine"), &o->refine);
 }
 
 }  // namespace wild_mvs

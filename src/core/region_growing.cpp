@@ -14,24 +14,15 @@
 #include "wild_mvs/core/error.h"
 
 namespace wild_mvs {
+namespace {
+// Side of a growth tile in pixels (the parallel unit).
+constexpr int kTileSize = 32;
+}  // namespace
 
 void RegionGrowingOptions::Check() const {
-  Require(tile_size >= 8 && tile_size <= 4096,
-          "mvs.growing.tile_size = ", tile_size, " must be in [8, 4096]");
   Require(revisit_margin >= 0 && revisit_margin <= 2,
           "mvs.growing.revisit_margin = ", revisit_margin,
           " must be in [0, 2] (NCC units)");
-  Require(hypotheses >= 0 && hypotheses <= 16,
-          "mvs.growing.hypotheses = ", hypotheses, " must be in [0, 16]");
-  Require(start_views >= 0 && start_views <= kMaxNeighbors,
-          "mvs.growing.start_views = ", start_views, " must be in [0, ",
-          kMaxNeighbors, "]");
-  Require(start_min_score >= -1 && start_min_score <= 1,
-          "mvs.growing.start_min_score = ", start_min_score,
-          " must be in [-1, 1]");
-  Require(expand_min_ncc >= -1 && expand_min_ncc <= 1,
-          "mvs.growing.expand_min_ncc = ", expand_min_ncc,
-          " must be in [-1, 1]");
 }
 
 double ThreadCpuSeconds() {
@@ -127,7 +118,7 @@ class RegionGrower {
         matchers_(context, mpgc, local),
         W_(context.ref_image.width),
         H_(context.ref_image.height),
-        T_(options.tile_size),
+        T_(kTileSize),
         ntx_((W_ + T_ - 1) / T_),
         nty_((H_ + T_ - 1) / T_),
         queues_(ntx_ * nty_),
@@ -136,15 +127,13 @@ class RegionGrower {
         // Given in NCC units; confidence = (NCC + 1) / 2.
         margin_(static_cast<float>(0.5 * options.revisit_margin)),
         min_score_(mpgc.drop_ncc),
-        expand_conf_(static_cast<float>(0.5 * (options.expand_min_ncc + 1))),
         // A held sample's explain verdict is not stored with the map: with
         // the explain test keeping unexplained matches, only held samples
         // above its gate (never tested) expand.
-        held_expand_conf_(std::max(
-            expand_conf_,
+        held_expand_conf_(
             mpgc.explain_margin >= 0 && mpgc.explain_keeps_match
                 ? static_cast<float>(0.5 * (mpgc.explain_below_ncc + 1))
-                : 0.0f)) {
+                : 0.0f) {
     if (!mask.empty()) mask_ = mask.isContinuous() ? mask : mask.clone();
     mmap_ = mask_.empty() ? nullptr : mask_.ptr<uint8_t>();
     dmap_ = depth->ptr<float>();
@@ -276,108 +265,6 @@ class RegionGrower {
     return !(have > 0) || (have < conf && conf - have > margin_);
   }
 
-  // The planes of (x, y)'s reconstructed 4-neighbours (order +x, -x, +y,
-  // -y), each carried to (x, y): its depth there and its normal. With
-  // `matched_only`, neighbours without a confidence (held seeds) are left
-  // out. Returns how many (<= 4).
-  int NeighbourPlanes(int x, int y, bool matched_only, double depth[4],
-                      Eigen::Vector3d normal[4]) const {
-    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
-    int n = 0;
-    for (int k = 0; k < 4; ++k) {
-      const int nx = x + dx[k], ny = y + dy[k];
-      if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
-      const int q = ny * W_ + nx;
-      if (!(dmap_[q] > 0) || (matched_only && !(cmap_[q] > 0))) continue;
-      const Eigen::Vector3d nq(nmap_[3 * q], nmap_[3 * q + 1],
-                               nmap_[3 * q + 2]);
-      const Eigen::Vector3d Xq =
-          cam_.BackprojectCam(Eigen::Vector2d(nx + 0.5, ny + 0.5), dmap_[q]);
-      const double d = PlaneDepthAt(cam_, x, y, Xq, nq, dmap_[q]);
-      if (!(d > 0) || !std::isfinite(d)) continue;
-      depth[n] = d;
-      normal[n++] = nq;
-    }
-    return n;
-  }
-
-  // Beyond the paper: when MPGC from the copied plane fails at (x, y), the
-  // planes of p's reconstructed 4-neighbours and perturbations of the
-  // copied plane are scored with the cheap NCC (no optimisation), and MPGC
-  // runs again from the best `hypotheses` of them that score above kappa.
-  bool MatchFromHypotheses(PatchMatcher* m, int x, int y, const Candidate& c,
-                           PatchResult* r, long long* visits) {
-    struct Hyp {
-      double score;
-      double depth;
-      Eigen::Vector3d n;
-    };
-    Hyp hyps[16];
-    int nh = 0;
-    const Eigen::Vector3d cn(c.normal[0], c.normal[1], c.normal[2]);
-    auto add = [&](double depth, const Eigen::Vector3d& n) {
-      if (nh >= 16 || !(depth > 0) || !std::isfinite(depth)) return;
-      const double score = m->PlaneScore(x, y, depth, n, 2);
-      if (score > min_score_) hyps[nh++] = {score, depth, n};
-    };
-    double nd[4];
-    Eigen::Vector3d nn[4];
-    const int nnb = NeighbourPlanes(x, y, false, nd, nn);
-    for (int i = 0; i < nnb; ++i) add(nd[i], nn[i]);
-    // Perturbations: depth +-1 % and the normal tilted by 15 degrees about
-    // the image axes (deterministic: no random numbers).
-    for (double f : {0.99, 1.01}) add(c.depth * f, cn);
-    const double a = 15 * M_PI / 180;
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d axis =
-          k < 2 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-      const Eigen::Vector3d n = Eigen::AngleAxisd(k % 2 ? a : -a, axis) * cn;
-      if (n.z() < -0.2) add(c.depth, n);
-    }
-    std::sort(hyps, hyps + nh,
-              [](const Hyp& u, const Hyp& v) { return u.score > v.score; });
-    for (int i = 0; i < std::min(nh, opt_.hypotheses); ++i) {
-      ++*visits;
-      if (m->Match(x, y, hyps[i].depth, hyps[i].n, r)) return true;
-    }
-    return false;
-  }
-
-  // start_views: the start of the first MPGC at an empty pixel (x, y):
-  // the candidate's copied plane or a reconstructed 4-neighbour's plane,
-  // whichever scores best with the cheap NCC (ties: the copied plane, then
-  // the neighbours in the order +x, -x, +y, -y). False (skip the pixel)
-  // when the best scores below start_min_score.
-  bool PickStart(PatchMatcher* m, int x, int y, const Candidate& c,
-                 double* depth, Eigen::Vector3d* normal) {
-    *depth = c.depth;
-    *normal = Eigen::Vector3d(c.normal[0], c.normal[1], c.normal[2]);
-    double nd[4], hd[4];
-    Eigen::Vector3d nn[4], hn[4];
-    int nh = 0;
-    const int nnb = NeighbourPlanes(x, y, true, nd, nn);
-    for (int i = 0; i < nnb; ++i) {
-      // The plane the candidate was copied from (float-rounded): no new
-      // hypothesis.
-      if (std::abs(nd[i] - c.depth) <= 1e-5 * nd[i] &&
-          nn[i].dot(*normal) > 1 - 1e-6)
-        continue;
-      hd[nh] = nd[i];
-      hn[nh++] = nn[i];
-    }
-    if (nh == 0 && !(opt_.start_min_score > -1)) return true;
-    double best = m->PlaneScore(x, y, *depth, *normal, 2, opt_.start_views);
-    for (int i = 0; i < nh; ++i) {
-      const double sc = m->PlaneScore(x, y, hd[i], hn[i], 2, opt_.start_views);
-      if (sc > best) {
-        best = sc;
-        *depth = hd[i];
-        *normal = hn[i];
-      }
-    }
-    return !(opt_.start_min_score > -1) || best >= opt_.start_min_score;
-  }
-
   // Best-first growth inside one tile: pop, match, store, push the four
   // neighbours with the same plane (those of other tiles to this tile's
   // outbox).
@@ -404,22 +291,15 @@ class RegionGrower {
       if (!WorthVisit(p, c.conf)) continue;
       const int x = p % W_, y = p / W_;
       ++visits_[tile];
-      double start_depth = c.depth;
-      Eigen::Vector3d start_normal(c.normal[0], c.normal[1], c.normal[2]);
-      if (opt_.start_views > 0 && !(cmap_[p] > 0) &&
-          !PickStart(m.get(), x, y, c, &start_depth, &start_normal))
-        continue;
-      if (!m->Match(x, y, start_depth, start_normal, &r) &&
-          !(opt_.hypotheses > 0 && !(cmap_[p] > 0) &&
-            MatchFromHypotheses(m.get(), x, y, c, &r, &visits_[tile])))
-        continue;
+      const Eigen::Vector3d start_normal(c.normal[0], c.normal[1], c.normal[2]);
+      if (!m->Match(x, y, c.depth, start_normal, &r)) continue;
       if (!(r.confidence > cmap_[p])) continue;
       const float conf = static_cast<float>(r.confidence);
       cmap_[p] = conf;
       dmap_[p] = static_cast<float>(r.depth);
       for (int k = 0; k < 3; ++k)
         nmap_[3 * p + k] = static_cast<float>(r.normal[k]);
-      if (conf < expand_conf_ || !r.explained) continue;  // not expanded
+      if (!r.explained) continue;  // not expanded
       const Eigen::Vector3d X0 =
           cam_.BackprojectCam(Eigen::Vector2d(x + 0.5, y + 0.5), r.depth);
       static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
@@ -470,8 +350,8 @@ class RegionGrower {
   std::vector<long long> visits_;
   const float margin_;
   const double min_score_;
-  const float expand_conf_;  // confidence below which a match does not expand
-  const float held_expand_conf_;  // the same for held samples
+  // Confidence below which a held sample does not expand.
+  const float held_expand_conf_;
   cv::Mat mask_;
   const uint8_t* mmap_ = nullptr;
   float* dmap_ = nullptr;
@@ -523,48 +403,12 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      RegionGrowingOptions* o) {
-  auto key = [&prefix](const char* name) {
-    return OptionRegistry::Join(prefix, name);
-  };
   registry
-      ->Add(key("tile_size"), &o->tile_size,
-            "region growing tile side in pixels (parallel unit)")
-      .Min(8)
-      .Max(4096);
-  registry->Add(key("seeds_from_neighbors"), &o->seeds_from_neighbors,
-                "also seed from the neighbours' features projected into R");
-  registry
-      ->Add(key("revisit_margin"), &o->revisit_margin,
+      ->Add(OptionRegistry::Join(prefix, "revisit_margin"), &o->revisit_margin,
             "revisit a pixel only from a candidate whose mean NCC beats the "
             "stored one by more than this, NCC units (paper: 0)")
       .Min(0)
       .Max(2);
-  registry
-      ->Add(key("hypotheses"), &o->hypotheses,
-            "when MPGC from the copied plane fails at an empty pixel, try "
-            "this many alternative planes (neighbours', perturbed) ranked by "
-            "NCC; 0 = paper")
-      .Min(0)
-      .Max(16);
-  registry
-      ->Add(key("start_views"), &o->start_views,
-            "before the first MPGC at an empty pixel, start from the best of "
-            "the copied plane and the 4-neighbours' planes by NCC over this "
-            "many views (best global score); 0 = off (paper)")
-      .Min(0)
-      .Max(kMaxNeighbors);
-  registry
-      ->Add(key("start_min_score"), &o->start_min_score,
-            "with start_views: skip the pixel when the best start's NCC (mean "
-            "of the best 2) is below this; -1 = off")
-      .Min(-1)
-      .Max(1);
-  registry
-      ->Add(key("expand_min_ncc"), &o->expand_min_ncc,
-            "a match whose mean NCC is below this is kept but does not "
-            "queue its neighbours; -1 = every match expands (paper)")
-      .Min(-1)
-      .Max(1);
 }
 
 }  // namespace wild_mvs

@@ -9,32 +9,6 @@
 
 namespace wild_mvs {
 
-void RescalingOptions::Check() const {
-  Require(min_scale > 0 && min_scale <= 1,
-          "mvs.rescaling.min_scale = ", min_scale, " must be in (0, 1]");
-  Require(max_scale >= 1, "mvs.rescaling.max_scale = ", max_scale,
-          " must be >= 1");
-}
-
-void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
-                     RescalingOptions* o) {
-  auto key = [&prefix](const char* name) {
-    return OptionRegistry::Join(prefix, name);
-  };
-  registry->Add(key("enabled"), &o->enabled,
-                "rescale the reference and neighbours to a common scale");
-  registry
-      ->Add(key("min_scale"), &o->min_scale,
-            "downsample the reference when the coarsest neighbour's scale is "
-            "below (paper: 0.6)")
-      .Above(0)
-      .Max(1);
-  registry
-      ->Add(key("max_scale"), &o->max_scale,
-            "downsample neighbours whose scale exceeds this (paper: 1.2)")
-      .Min(1);
-}
-
 double ScaleRatio(const Scene& scene, int ref, int view,
                   const std::vector<std::vector<int>>& points_per_view,
                   const Eigen::Vector3d* fallback_point) {
@@ -64,8 +38,7 @@ double ScaleRatio(const Scene& scene, int ref, int view,
 
 RescalingPlan PlanRescaling(const Scene& scene, int ref,
                             const std::vector<int>& neighbors,
-                            const std::vector<double>& scales,
-                            const RescalingOptions& options,
+                            const std::vector<double>& scales, bool rescale,
                             int max_image_size) {
   Require(scales.size() == neighbors.size(),
           "PlanRescaling: one scale per neighbour expected");
@@ -73,9 +46,9 @@ RescalingPlan PlanRescaling(const Scene& scene, int ref,
   plan.scales = scales;
   const Camera& cr = scene.views[ref].camera;
   double f = 1.0;
-  if (options.enabled && !scales.empty()) {
+  if (rescale && !scales.empty()) {
     const double smin = *std::min_element(scales.begin(), scales.end());
-    if (smin < options.min_scale) f = smin / options.min_scale;
+    if (smin < kRescaleMinScale) f = smin / kRescaleMinScale;
   }
   if (max_image_size > 0) {
     const int longest = std::max(cr.width, cr.height);
@@ -92,7 +65,7 @@ RescalingPlan PlanRescaling(const Scene& scene, int ref,
     // After R's rescale, scale_R(V) becomes scales[i] / fr; a neighbour
     // above max_scale is downsampled to R's new scale (ratio 1).
     const double s = scales[i] / fr;
-    if (options.enabled && s > options.max_scale) {
+    if (rescale && s > kRescaleMaxScale) {
       plan.neighbor_cameras.push_back(cv.Scaled(1.0 / s));
     } else if (max_image_size > 0 &&
                std::max(cv.width, cv.height) > max_image_size) {

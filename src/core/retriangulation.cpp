@@ -10,6 +10,9 @@ namespace wild_mvs {
 
 using sparse_internal::AreOrientationTwins;
 using sparse_internal::kDeg;
+using sparse_internal::kMaxOutlierRemovals;
+using sparse_internal::kMaxScaleRatio;
+using sparse_internal::kRefineIterations;
 
 namespace {
 
@@ -54,36 +57,10 @@ void SparseTracker::Impl::Rebuild(int root) {
       conflicting.push_back(kv.first);
     }
   }
-  if (!conflicting.empty()) {
+  if (!conflicting.empty()) {  // a wrong match joined two points
     pd.conflict = true;
-    if (!opt.resolve_conflicts ||
-        static_cast<int>(nodes.size()) < opt.min_track_length) {
-      points[root] = pd;
-      return;
-    }
-    // Point from the unambiguous views; in each conflicting view keep the
-    // feature that reprojects best, if within the error bound.
-    std::vector<TriangulationInput> clean;
-    for (int n : nodes) {
-      const ViewData& v = views[node_slot[n]];
-      clean.push_back({&v.camera, v.features.xy[n - v.offset].cast<double>()});
-    }
-    Eigen::Vector3d Xc;
-    if (!Triangulate(clean, &Xc, opt.refine_iterations)) {
-      points[root] = pd;
-      return;
-    }
-    for (int s : conflicting) {
-      const ViewData& v = views[s];
-      int best = -1;
-      double best_err = opt.max_reprojection_error;
-      for (int n : by_slot[s]) {
-        const double e = ReprojectionError(
-            v.camera, Xc, v.features.xy[n - v.offset].cast<double>());
-        if (e <= best_err) best_err = e, best = n;
-      }
-      if (best >= 0) nodes.push_back(best);
-    }
+    points[root] = pd;
+    return;
   }
   if (static_cast<int>(nodes.size()) < opt.min_track_length) {
     points[root] = pd;
@@ -98,7 +75,7 @@ void SparseTracker::Impl::Rebuild(int root) {
     obs.push_back({&v.camera, v.features.xy[n - v.offset].cast<double>()});
   }
   Eigen::Vector3d X;
-  bool ok = Triangulate(obs, &X, opt.refine_iterations);
+  bool ok = Triangulate(obs, &X, kRefineIterations);
   std::vector<double> err(obs.size());
   for (int removal = 0; ok; ++removal) {
     size_t worst = 0;
@@ -107,7 +84,7 @@ void SparseTracker::Impl::Rebuild(int root) {
       if (!(err[k] <= err[worst])) worst = k;
     }
     if (err[worst] <= opt.max_reprojection_error) break;
-    if (removal >= opt.max_outlier_removals ||
+    if (removal >= kMaxOutlierRemovals ||
         static_cast<int>(obs.size()) <= opt.min_track_length) {
       ok = false;
       break;
@@ -115,14 +92,14 @@ void SparseTracker::Impl::Rebuild(int root) {
     obs.erase(obs.begin() + worst);
     nodes.erase(nodes.begin() + worst);
     err.pop_back();
-    ok = Triangulate(obs, &X, opt.refine_iterations);
+    ok = Triangulate(obs, &X, kRefineIterations);
   }
   if (ok) {
     for (const TriangulationInput& o : obs) {
       if (!(o.camera->Depth(X) > 0)) ok = false;
     }
   }
-  if (ok && opt.max_scale_ratio > 0) {
+  if (ok) {
     // The feature's size in the world (SIFT scale x pixel footprint at its
     // depth) must agree between the views: a false match along the
     // epipolar line usually pairs blobs of different sizes.
@@ -134,7 +111,7 @@ void SparseTracker::Impl::Rebuild(int root) {
       lo = std::min(lo, w);
       hi = std::max(hi, w);
     }
-    if (lo > 0 && hi > opt.max_scale_ratio * lo) ok = false;
+    if (lo > 0 && hi > kMaxScaleRatio * lo) ok = false;
   }
   if (ok &&
       MaxTriangulationAngle(obs, X) < opt.min_triangulation_angle_deg * kDeg) {

@@ -23,37 +23,16 @@ void TrackerOptions::Check() const {
   features.Check();
   Require(max_neighbors >= 1, "tracker.max_neighbors = ", max_neighbors,
           " must be >= 1");
-  Require(min_overlap >= 0 && min_overlap <= 1,
-          "tracker.min_overlap = ", min_overlap, " must be in [0, 1]");
-  Require(max_pair_angle_deg > 0 && max_pair_angle_deg <= 180,
-          "tracker.max_pair_angle_deg = ", max_pair_angle_deg,
-          " must be in (0, 180]");
   Require(scene_depth >= 0 && std::isfinite(scene_depth),
           "tracker.scene_depth = ", scene_depth, " must be >= 0 (0 = auto)");
-  Require(max_epipolar_distance > 0,
-          "tracker.max_epipolar_distance = ", max_epipolar_distance,
-          " must be > 0");
-  Require(ratio > 0 && ratio <= 1, "tracker.ratio = ", ratio,
-          " must be in (0, 1]");
-  Require(max_descriptor_distance > 0 && max_descriptor_distance <= 2,
-          "tracker.max_descriptor_distance = ", max_descriptor_distance,
-          " must be in (0, 2]");
   Require(max_reprojection_error > 0,
           "tracker.max_reprojection_error = ", max_reprojection_error,
           " must be > 0");
-  Require(max_outlier_removals >= 0,
-          "tracker.max_outlier_removals = ", max_outlier_removals,
-          " must be >= 0");
   Require(min_triangulation_angle_deg >= 0 && min_triangulation_angle_deg < 90,
           "tracker.min_triangulation_angle_deg = ", min_triangulation_angle_deg,
           " must be in [0, 90)");
   Require(min_track_length >= 2,
           "tracker.min_track_length = ", min_track_length, " must be >= 2");
-  Require(max_scale_ratio == 0 || max_scale_ratio >= 1,
-          "tracker.max_scale_ratio = ", max_scale_ratio,
-          " must be 0 (off) or >= 1");
-  Require(refine_iterations >= 0,
-          "tracker.refine_iterations = ", refine_iterations, " must be >= 0");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -67,63 +46,22 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "match each view against at most this many earlier views")
       .Min(1);
   registry
-      ->Add(key("min_overlap"), &o->min_overlap,
-            "minimum frustum overlap fraction of a candidate pair")
-      .Min(0)
-      .Max(1);
-  registry
-      ->Add(key("max_pair_angle_deg"), &o->max_pair_angle_deg,
-            "do not match pairs whose optical axes differ by more (degrees)")
-      .Above(0)
-      .Max(180);
-  registry
       ->Add(key("scene_depth"), &o->scene_depth,
             "typical scene depth for the overlap test, 0 = automatic")
       .Min(0);
   registry
-      ->Add(key("max_epipolar_distance"), &o->max_epipolar_distance,
-            "accept matches within this distance of the epipolar line (px)")
-      .Above(0);
-  registry->Add(key("ratio"), &o->ratio, "Lowe's ratio test threshold")
-      .Above(0)
-      .Max(1);
-  registry
-      ->Add(key("max_descriptor_distance"), &o->max_descriptor_distance,
-            "bound on the L2 distance of unit-normalised descriptors")
-      .Above(0)
-      .Max(2);
-  registry->Add(key("mutual"), &o->mutual,
-                "keep a match only when best in both directions");
-  registry
       ->Add(key("max_reprojection_error"), &o->max_reprojection_error,
             "remove observations reprojecting farther (px)")
       .Above(0);
-  registry
-      ->Add(key("max_outlier_removals"), &o->max_outlier_removals,
-            "at most this many observations removed per track")
-      .Min(0);
   registry
       ->Add(key("min_triangulation_angle_deg"), &o->min_triangulation_angle_deg,
             "a point's largest pairwise viewing angle must reach this (deg)")
       .Min(0)
       .Below(90);
   registry
-      ->Add(key("max_scale_ratio"), &o->max_scale_ratio,
-            "feature scales of a track may differ by at most this factor, "
-            "0 = off")
-      .Min(1)
-      .OrZero();
-  registry->Add(key("resolve_conflicts"), &o->resolve_conflicts,
-                "keep the best feature of a view with two in one track (else "
-                "reject the track)");
-  registry
       ->Add(key("min_track_length"), &o->min_track_length,
             "tracks seen in fewer views produce no point")
       .Min(2);
-  registry
-      ->Add(key("refine_iterations"), &o->refine_iterations,
-            "Gauss-Newton iterations of the triangulation refinement")
-      .Min(0);
   // `compact` is a test switch (the results are the same), not an option.
 }
 

@@ -20,6 +20,25 @@ namespace wild_mvs {
 namespace sparse_internal {
 
 constexpr double kDeg = M_PI / 180.0;
+// Pair selection: a candidate pair needs at least this fraction of sample
+// points of the new view's frustum to project into the other image, and
+// optical axes at most kMaxPairAngleDeg apart (SIFT rarely matches beyond).
+constexpr double kMinOverlap = 0.1;
+constexpr double kMaxPairAngleDeg = 75;
+// Matching: a match lies within kMaxEpipolarDistance px of the epipolar
+// line of the known fundamental matrix in both images and passes Lowe's
+// ratio test (best < kRatio * second best) among the compatible candidates;
+// bound on the L2 distance of unit-normalised descriptors (0..2);
+// a match must be the best in both directions.
+constexpr double kMaxEpipolarDistance = 1.5;
+constexpr double kRatio = 0.8;
+constexpr double kMaxDescriptorDistance = 0.7;
+// Re-triangulation: Gauss-Newton iterations; observations removed per track
+// at most (worst first, never below min_track_length); the largest ratio of
+// a track's feature sizes in the world (SIFT scale x pixel footprint).
+constexpr int kRefineIterations = 10;
+constexpr int kMaxOutlierRemovals = 3;
+constexpr double kMaxScaleRatio = 1.8;
 
 // SIFT reports one keypoint per dominant orientation, at the same position
 // and size: such twins in one view are the same point. (Distinct features
@@ -49,7 +68,7 @@ using Match = std::pair<int, int>;  // (feature in new view, feature in old)
 
 // Matches the features fa of camera ca to the features fb of camera cb
 // along the epipolar geometry (guided matching): candidates within
-// max_epipolar_distance of the epipolar line in both directions, Lowe's
+// kMaxEpipolarDistance of the epipolar line in both directions, Lowe's
 // ratio test (orientation twins of the best do not count as second best),
 // the descriptor-distance bound and, optionally, mutual best.
 std::vector<Match> GuidedMatches(const Camera& ca, const Features& fa,

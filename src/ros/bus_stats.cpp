@@ -62,15 +62,15 @@ std::map<std::string, uint64_t> RoscppQueueDrops() {
 }
 
 void RoscppDropWatch::Update(
-    const std::map<std::string, std::string>& topic_to_param,
+    const std::map<std::string, std::string>& topic_to_hint,
     DropCounter* drops) {
   const std::map<std::string, uint64_t> now = RoscppQueueDrops();
-  for (const auto& [topic, param] : topic_to_param) {
+  for (const auto& [topic, hint] : topic_to_hint) {
     auto it = now.find(topic);
     if (it == now.end()) continue;
     uint64_t& seen = seen_[topic];
     if (it->second > seen)
-      drops->CountMany(topic + ": roscpp queue full (raise ~" + param + ")",
+      drops->CountMany(topic + ": roscpp queue full (" + hint + ")",
                        it->second - seen);
     seen = std::max(seen, it->second);
   }

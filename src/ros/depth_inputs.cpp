@@ -52,7 +52,7 @@ void DepthInputs::Subscribe(FrameFn on_frame, PointsFn on_points) {
     tf_listener_ =
         std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_, true);
   }
-  const int q = o.pose_queue_size;
+  const int q = kPoseQueueSize;
   if (o.pose_source == "pose" || o.pose_source == "topic") {
     pose_sub_ = nh_.subscribe("pose", q, &DepthInputs::OnPoseStamped, this);
   } else if (o.pose_source == "pose_with_covariance") {
@@ -66,24 +66,24 @@ void DepthInputs::Subscribe(FrameFn on_frame, PointsFn on_points) {
   if (o.sparse_source == "topic")
     points_sub_ =
         nh_.subscribe("sparse_points", 2, &DepthInputs::OnSparsePoints, this);
-  info_sub_ = nh_.subscribe(info_topic_, o.camera_info_queue_size,
+  info_sub_ = nh_.subscribe(info_topic_, kCameraInfoQueueSize,
                             &DepthInputs::OnInfo, this);
   it_ = std::make_unique<image_transport::ImageTransport>(nh_);
   const std::vector<std::string> plugins = it_->getLoadableTransports();
   const bool have_plugin = std::find(plugins.begin(), plugins.end(),
                                      o.image_transport) != plugins.end();
   if (o.image_transport == "raw" || have_plugin) {
-    image_sub_ = it_->subscribe(
-        image_topic_, o.image_queue_size, &DepthInputs::OnRaw, this,
-        image_transport::TransportHints(o.image_transport,
-                                        ros::TransportHints(), pnh_,
-                                        "image_transport_hints"));
+    image_sub_ =
+        it_->subscribe(image_topic_, kImageQueueSize, &DepthInputs::OnRaw, this,
+                       image_transport::TransportHints(
+                           o.image_transport, ros::TransportHints(), pnh_,
+                           "image_transport_hints"));
   } else if (o.image_transport == "compressed") {
     // No compressed plugin installed (Debian 12 ships none): take
     // <image>/compressed and decode it here. "image" is remapped as a
     // whole name, so it is resolved before appending.
     compressed_sub_ =
-        nh_.subscribe(image_topic_ + "/compressed", o.image_queue_size,
+        nh_.subscribe(image_topic_ + "/compressed", kImageQueueSize,
                       &DepthInputs::OnCompressed, this);
   } else {
     std::string names;
@@ -179,10 +179,13 @@ void DepthInputs::Stop() {
 
 std::map<std::string, std::string> DepthInputs::QueueParams() const {
   std::map<std::string, std::string> out;
-  if (image_sub_) out[image_sub_.getTopic()] = "image_queue_size";
-  if (compressed_sub_) out[compressed_sub_.getTopic()] = "image_queue_size";
-  if (info_sub_) out[info_sub_.getTopic()] = "camera_info_queue_size";
-  if (pose_sub_) out[pose_sub_.getTopic()] = "pose_queue_size";
+  if (image_sub_)
+    out[image_sub_.getTopic()] = "the node falls behind the images";
+  if (compressed_sub_)
+    out[compressed_sub_.getTopic()] = "the node falls behind the images";
+  if (info_sub_)
+    out[info_sub_.getTopic()] = "the node falls behind camera_info";
+  if (pose_sub_) out[pose_sub_.getTopic()] = "the node falls behind the poses";
   return out;
 }
 
@@ -260,8 +263,8 @@ bool DepthInputs::ConvertImage(const DepthFrame& f, Camera* cam,
                                cv::Mat* image) {
   const std::string image_topic = ImageTopic(f);
   try {
-    *image = f.raw ? ImageToLinearRgb(*f.raw, options_.linearize)
-                   : CompressedToLinearRgb(*f.compressed, options_.linearize);
+    *image = f.raw ? ImageToLinearRgb(*f.raw, true)
+                   : CompressedToLinearRgb(*f.compressed, true);
   } catch (const Error& e) {
     drop_(image_topic, "invalid image", e.what());
     return false;
@@ -352,10 +355,10 @@ bool DepthInputs::LookupPose(const DepthFrame& f, Camera* cam) {
     return true;
   }
   // Pose topic: interpolated at the image stamp (slerp + lerp between the
-  // poses around it, at most pose_max_gap apart), never extrapolated.
+  // poses around it, at most kPoseMaxGap apart), never extrapolated.
   Eigen::Isometry3d world_T_frame;
   const PoseTrack::Result r =
-      poses_.WaitAt(f.stamp.toNSec(), o.pose_sync_tolerance, o.pose_max_gap,
+      poses_.WaitAt(f.stamp.toNSec(), kPoseSyncTolerance, kPoseMaxGap,
                     o.tf_timeout, &world_T_frame);
   if (!PoseTrack::Ok(r)) {
     drop_(Topic("pose"), PoseTrack::Describe(r), "");

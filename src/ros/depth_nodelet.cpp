@@ -227,7 +227,8 @@ struct DepthNode::Impl {
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     std::map<std::string, std::string> queues = inputs->QueueParams();
-    if (keyframe_sub) queues[keyframe_sub.getTopic()] = "keyframe_queue_size";
+    if (keyframe_sub)
+      queues[keyframe_sub.getTopic()] = "the worker falls behind the keyframes";
     roscpp_drops.Update(queues, &drops);
     const StreamStats s = stream->Stats();
     DepthInputStats in;
@@ -299,7 +300,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       });
   // A worker's queue holds keyframes (a few per second at most).
   m.queue = std::make_unique<WorkQueue<DepthFrame>>(
-      o.role == "worker" ? o.keyframe_queue_size : o.input_queue_size,
+      o.role == "worker" ? kKeyframeQueueSize : o.input_queue_size,
       [&m](DepthFrame f) { m.FrontEnd(std::move(f)); });
   if (o.role == "worker") {
     m.receiver = std::make_unique<KeyframeReceiver>(
@@ -310,7 +311,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
         [&m](const std::string& topic, const std::string& problem,
              const std::string& detail) { m.Drop(topic, problem, detail); });
     m.keyframe_sub = m.nh.subscribe<wild_mvs::SelectedKeyframe>(
-        "keyframes", o.keyframe_queue_size,
+        "keyframes", kKeyframeQueueSize,
         [&m](const wild_mvs::SelectedKeyframeConstPtr& k) {
           DepthFrame f;
           f.keyframe = k;
@@ -326,7 +327,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   } else {
     if (o.role == "selector") {
       m.announcer = std::make_unique<KeyframeAnnouncer>(m.pnh, o.world_frame,
-                                                        o.keyframe_history);
+                                                        kKeyframeHistory);
       m.index_timer = m.nh.createSteadyTimer(
           ros::WallDuration(1.0),
           [&m](const ros::SteadyTimerEvent&) { m.announcer->PublishIndex(); });
@@ -358,8 +359,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       std::vector<std::string>{
           "keyframe_min_baseline", "keyframe_min_angle_deg",
           "mvs.max_image_size", "mvs.global.num_neighbors", "mvs.local.min_ncc",
-          "mvs.mpgc.drop_ncc", "mvs.mpgc.accept_ncc", "mvs.mpgc.min_facing",
-          "mvs.mpgc.min_texture_levels", "mvs.growing.revisit_margin"},
+          "mvs.mpgc.drop_ncc", "mvs.growing.revisit_margin"},
       [&m] {
         m.live.Check();
         m.stream->SetOptions(m.live.stream);

@@ -201,7 +201,7 @@ struct FusionNode::Impl {
   }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-    roscpp_drops.Update({{sub.getTopic(), "input_queue_size"}}, &drops);
+    roscpp_drops.Update({{sub.getTopic(), "raise ~input_queue_size"}}, &drops);
     const uint64_t received = queue->received();
     const size_t queued = queue->size();
     FillFusionDiagnostics(session->Stats(), received, queued, drops, stat);

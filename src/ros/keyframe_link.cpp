@@ -114,8 +114,7 @@ bool KeyframeAnnouncer::OnGet(wild_mvs::GetKeyframe::Request& req,
   res.found = false;
   res.message =
       Msg("keyframe ", req.keyframe_id, " of session ", req.session.toNSec(),
-          " is not among the selector's newest ", history_size_,
-          " (~keyframe_history)");
+          " is not among the selector's newest ", history_size_);
   return true;
 }
 

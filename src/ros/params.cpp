@@ -110,14 +110,6 @@ void DepthNodeOptions::Check() const {
           "pose_source = '", pose_source,
           "' must be tf, pose (or topic), pose_with_covariance, transform or "
           "odometry");
-  Require(
-      std::isfinite(pose_max_gap) && pose_max_gap >= 0 && pose_max_gap <= 10,
-      "pose_max_gap = ", pose_max_gap, " must be in [0, 10] s");
-  for (const auto& [name, q] :
-       {std::pair<const char*, int>{"pose_queue_size", pose_queue_size},
-        {"image_queue_size", image_queue_size},
-        {"camera_info_queue_size", camera_info_queue_size}})
-    Require(q >= 1 && q <= 10000, name, " = ", q, " must be in [1, 10000]");
   if (!camera_extrinsic.empty()) ParseCameraExtrinsic(camera_extrinsic);
   Require(!image_transport.empty() &&
               image_transport.find_first_of("/ ") == std::string::npos,
@@ -132,8 +124,6 @@ void DepthNodeOptions::Check() const {
           "' must be 'tracker', 'topic' or 'none'");
   Require(std::isfinite(tf_timeout) && tf_timeout >= 0 && tf_timeout <= 60,
           "tf_timeout = ", tf_timeout, " must be in [0, 60] s");
-  Require(std::isfinite(pose_sync_tolerance) && pose_sync_tolerance >= 0,
-          "pose_sync_tolerance = ", pose_sync_tolerance, " must be >= 0");
   Require(input_queue_size >= 1 && input_queue_size <= 1000,
           "input_queue_size = ", input_queue_size, " must be in [1, 1000]");
   Require(std::isfinite(diagnostics_period) && diagnostics_period > 0,
@@ -145,11 +135,6 @@ void DepthNodeOptions::Check() const {
       "drop_window = ", drop_window, " must be in [0.1, 86400] s");
   Require(role == "standalone" || role == "selector" || role == "worker",
           "role = '", role, "' must be 'standalone', 'selector' or 'worker'");
-  Require(keyframe_queue_size >= 1 && keyframe_queue_size <= 10000,
-          "keyframe_queue_size = ", keyframe_queue_size,
-          " must be in [1, 10000]");
-  Require(keyframe_history >= 1 && keyframe_history <= 10000,
-          "keyframe_history = ", keyframe_history, " must be in [1, 10000]");
   Require(
       std::isfinite(repair_delay) && repair_delay >= 0 && repair_delay <= 3600,
       "repair_delay = ", repair_delay, " must be in [0, 3600] s");
@@ -220,27 +205,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "odometry (nav_msgs/Odometry)")
       .OneOf({"tf", "topic", "pose", "pose_with_covariance", "transform",
               "odometry"});
-  registry
-      ->Add(key("pose_max_gap"), &o->pose_max_gap,
-            "s, topic poses are interpolated only between poses at most this "
-            "far apart")
-      .Min(0)
-      .Max(10);
-  registry
-      ->Add(key("pose_queue_size"), &o->pose_queue_size,
-            "roscpp queue of the pose subscription")
-      .Min(1)
-      .Max(10000);
-  registry
-      ->Add(key("image_queue_size"), &o->image_queue_size,
-            "roscpp queue of the image subscription (overflows counted)")
-      .Min(1)
-      .Max(10000);
-  registry
-      ->Add(key("camera_info_queue_size"), &o->camera_info_queue_size,
-            "roscpp queue of the camera_info subscription")
-      .Min(1)
-      .Max(10000);
   registry->Add(key("pose_frame"), &o->pose_frame,
                 "frame the topic poses are of; \"\" = the camera (pose), the "
                 "child_frame_id (transform, odometry); a body frame needs "
@@ -255,11 +219,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "s to wait for the pose of a frame")
       .Min(0)
       .Max(60);
-  registry
-      ->Add(key("pose_sync_tolerance"), &o->pose_sync_tolerance,
-            "s, a topic pose this close to the image stamp is used as is when "
-            "no two poses around the stamp can be interpolated")
-      .Min(0);
   registry->Add(key("camera_frame"), &o->camera_frame,
                 "camera optical frame; \"\" = the image header's frame_id");
   registry
@@ -282,8 +241,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("sparse_source"), &o->sparse_source,
             "tracker (online SIFT tracks), topic (`sparse_points`), none")
       .OneOf({"tracker", "topic", "none"});
-  registry->Add(key("linearize"), &o->linearize,
-                "inverse sRGB on input images");
   registry
       ->Add(key("input_queue_size"), &o->input_queue_size,
             "frames waiting for the front end; the oldest is dropped "
@@ -308,16 +265,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "standalone (select and reconstruct), selector (select, publish "
             "~keyframes for workers), worker (keyframes from `keyframes`)")
       .OneOf({"standalone", "selector", "worker"});
-  registry
-      ->Add(key("keyframe_queue_size"), &o->keyframe_queue_size,
-            "worker: roscpp queue of `keyframes`")
-      .Min(1)
-      .Max(10000);
-  registry
-      ->Add(key("keyframe_history"), &o->keyframe_history,
-            "selector: newest keyframes kept for ~get_keyframe")
-      .Min(1)
-      .Max(10000);
   registry
       ->Add(key("repair_delay"), &o->repair_delay,
             "worker: s before an announced keyframe that did not arrive is "

@@ -61,8 +61,8 @@ std::string PoseTrack::Describe(Result r) {
       return "no pose at or after the image stamp arrived within "
              "tf_timeout (poses are interpolated, never extrapolated)";
     case Result::kGapTooLarge:
-      return "the poses before and after the image stamp are more than "
-             "pose_max_gap apart (not interpolated across the gap)";
+      return "the poses before and after the image stamp are too far apart "
+             "(not interpolated across the gap)";
   }
   return "?";
 }

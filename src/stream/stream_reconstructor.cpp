@@ -40,16 +40,10 @@ void StreamOptions::Check() const {
   Require(lookahead >= 0, "lookahead = ", lookahead, " must be >= 0");
   Require(std::isfinite(idle_flush) && idle_flush >= 0,
           "idle_flush = ", idle_flush, " must be >= 0 (seconds)");
-  Require(
-      std::isfinite(redo_min_gain) && (redo_min_gain == 0 || redo_min_gain > 1),
-      "redo_min_gain = ", redo_min_gain, " must be 0 (off) or > 1");
-  Require(max_redo >= 0, "max_redo = ", max_redo, " must be >= 0");
   Require(max_image_size == 0 || max_image_size >= 16,
           "max_image_size = ", max_image_size, " must be 0 (off) or >= 16");
   Require(std::isfinite(max_pose_jump) && max_pose_jump >= 0,
           "max_pose_jump = ", max_pose_jump, " must be >= 0 (0 = off)");
-  Require(std::isfinite(stamp_reset_threshold) && stamp_reset_threshold > 0,
-          "stamp_reset_threshold = ", stamp_reset_threshold, " must be > 0");
   mvs.Check();
   if (use_tracker) tracker.Check();
 }
@@ -161,7 +155,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.frames;
     if (last_stamp_ >= 0 && stamp <= last_stamp_) {
-      if (last_stamp_ - stamp > options_.stamp_reset_threshold) {
+      if (last_stamp_ - stamp > kStampResetSeconds) {
         ClearLocked();
         status = FrameStatus::kReset;
       } else {
@@ -267,7 +261,7 @@ bool StreamReconstructor::IsOutOfOrder(uint64_t stamp_ns) const {
   const double stamp = StampSeconds(stamp_ns);
   std::lock_guard<std::mutex> lock(mutex_);
   return last_stamp_ >= 0 && stamp <= last_stamp_ &&
-         last_stamp_ - stamp <= options_.stamp_reset_threshold;
+         last_stamp_ - stamp <= kStampResetSeconds;
 }
 
 void StreamReconstructor::SetSparsePoints(
@@ -363,9 +357,7 @@ void StreamReconstructor::ScheduleLocked() {
   // could be scheduled.
   auto schedulable = [this](const KeyframePtr& kf) {
     if (!kf->owned || in_flight_.count(kf->id)) return false;
-    return kf->reconstructions == 0 ||
-           (options_.redo_min_gain > 0 &&
-            kf->reconstructions <= options_.max_redo);
+    return kf->reconstructions == 0;
   };
   const std::vector<KeyframePtr> all = store_.All();
   if (std::none_of(all.begin(), all.end(), schedulable)) return;
@@ -375,23 +367,16 @@ void StreamReconstructor::ScheduleLocked() {
   for (size_t i = 0; i < snap.keyframes.size(); ++i) {
     const KeyframePtr& kf = snap.keyframes[i];
     if (!kf->owned || in_flight_.count(kf->id)) continue;
-    const bool redo = kf->reconstructions > 0;
-    if (redo && (options_.redo_min_gain <= 0 ||
-                 kf->reconstructions > options_.max_redo))
-      continue;
+    if (kf->reconstructions > 0) continue;
     const Neighborhood nb = Evaluate(snap, static_cast<int>(i));
     // MPGC needs min_active_views neighbours to match at all.
     if (nb.good <
         std::max(options_.min_neighbors, options_.mvs.mpgc.min_active_views))
       continue;
-    if (redo) {
-      if (nb.score < kf->neighbor_score * options_.redo_min_gain) continue;
-    } else {
-      const bool ready =
-          static_cast<int>(newest - kf->id) >= options_.lookahead ||
-          nb.good >= options_.mvs.global.num_neighbors || idle;
-      if (!ready) continue;
-    }
+    const bool ready =
+        static_cast<int>(newest - kf->id) >= options_.lookahead ||
+        nb.good >= options_.mvs.global.num_neighbors || idle;
+    if (!ready) continue;
     if (static_cast<int>(in_flight_.size()) >= options_.max_pending) {
       ++ready_waiting_;  // ready, waits for a free slot
       continue;
@@ -608,11 +593,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
     return OptionRegistry::Join(prefix, name);
   };
   registry
-      ->Add(key("stamp_reset_threshold"), &o->stamp_reset_threshold,
-            "s: a stamp this far back resets the stream (bag loop); smaller "
-            "steps back are dropped")
-      .Above(0);
-  registry
       ->Add(key("max_pose_jump"), &o->max_pose_jump,
             "m between frames < 1 s apart that count as a pose reset, 0 = off")
       .Min(0);
@@ -643,16 +623,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("idle_flush"), &o->idle_flush,
             "s without a new keyframe after which ready keyframes are "
             "reconstructed")
-      .Min(0);
-  registry
-      ->Add(key("redo_min_gain"), &o->redo_min_gain,
-            "redo a keyframe when its neighbour score grew by this factor, "
-            "0 = never")
-      .Above(1)
-      .OrZero();
-  registry
-      ->Add(key("max_redo"), &o->max_redo,
-            "at most this many redos per keyframe")
       .Min(0);
   registry
       ->Add(key("worker_index"), &o->worker_index,

@@ -31,14 +31,14 @@ expect_fail 1 "run.threads = -3 must be in \\[0, 4096\\]" -- \
   "$WILD_MVS" $R A B --threads -3
 expect_fail 1 "mpgc.window = 4 must be odd and in \\[3, 9\\]" -- \
   "$WILD_MVS" $R A B --mvs.mpgc.window 4
-expect_fail 1 "mpgc.min_facing = 1 must be in \\[0, 1\\)" -- \
-  "$WILD_MVS" $R A B --mvs.mpgc.min_facing=1
+expect_fail 1 "mpgc.drop_ncc = 2 must be in \\[-1, 1\\]" -- \
+  "$WILD_MVS" $R A B --mvs.mpgc.drop_ncc=2
 expect_fail 2 "option --threads: run.threads: 'many' is not an integer" -- \
   "$WILD_MVS" $R A B --threads many
 expect_fail 2 "option --image.cache_mb: 'nan' is not a finite number" -- \
   "$WILD_MVS" $R A B --image.cache_mb nan
-expect_fail 2 "option --image.linearize: 'maybe' is not a boolean" -- \
-  "$WILD_MVS" $R A B --image.linearize=maybe
+expect_fail 2 "option --ablation.linearize: 'maybe' is not a boolean" -- \
+  "$WILD_MVS" $R A B --ablation.linearize=maybe
 expect_fail nz "run.stages: unknown stage 'paint'" -- \
   "$WILD_MVS" $R A B --stages depth,paint
 expect_fail 2 "unknown option --image.cache" -- \
@@ -46,8 +46,8 @@ expect_fail 2 "unknown option --image.cache" -- \
 
 # Config files: errors name the file, the line and the key.
 CFG="$TMP/bad.yaml"
-printf 'run:\n  threads: 2\nimage:\n  linearise: true\n' >"$CFG"
-expect_fail 1 "bad.yaml line 4: unknown option 'image.linearise'.*image.linearize" \
+printf 'run:\n  threads: 2\nimage:\n  cache_m: 10\n' >"$CFG"
+expect_fail 1 "bad.yaml line 4: unknown option 'image.cache_m'.*image.cache_mb" \
   -- "$WILD_MVS" $R --config "$CFG" A B
 printf 'image:\n  cache_mb: 10\n  max_image_size: -5\n' >"$CFG"
 expect_fail 1 "image.max_image_size = -5 must be >= 0" \

@@ -54,13 +54,15 @@ TEST(Params, ReconstructYamlLoadsIntoTheNodes) {
   RegisterOptions(&depth, "", &d);
   ExpectSameValues(cli, depth, "mvs");
   ExpectSameValues(cli, depth, "tracker");
-  EXPECT_EQ(d.stream.mvs.mpgc.settle_iterations, 4);
-  EXPECT_EQ(d.stream.mvs.sweep.num_views, 3);
-  EXPECT_FALSE(d.stream.mvs.local.enabled);
+  EXPECT_EQ(d.stream.mvs.mpgc.min_active_views, 2);
+  EXPECT_EQ(d.stream.mvs.sweep.below_seeds, 4);
+  EXPECT_DOUBLE_EQ(d.stream.mvs.local.min_ncc, 0.25);
   // The depth node knows every mvs/ and tracker/ key; the other sections of
   // reconstruct.yaml are the CLI's (reported as unknown, not errors).
   for (const std::string& name : UnknownDepthNodeParams(params)) {
     EXPECT_TRUE(name.rfind("run/", 0) == 0 || name.rfind("image/", 0) == 0 ||
+                name.rfind("consistency/", 0) == 0 ||
+                name.rfind("ablation/", 0) == 0 ||
                 name.rfind("fusion/", 0) == 0 || name.rfind("meshing/", 0) == 0)
         << name;
   }

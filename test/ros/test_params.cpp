@@ -36,16 +36,11 @@ TEST(Params, ValuesReachTheCoreOptions) {
                     {"sparse_source", std::string("topic")},
                     {"mvs/global/num_neighbors", 6},
                     {"mvs/local/min_ncc", 0.35},
-                    {"mvs/mpgc/optimize_color_scale", false},
+                    {"mvs/mpgc/bilateral_sigma_color", 8.0},
                     {"tracker/features/max_features", 1500},
                     {"max_keyframe_mb", 128.0},
-                    // Options the hand-written binder did not have.
-                    {"mvs/mpgc/settle_iterations", 4},
-                    {"mvs/mpgc/full_update_interval", 3},
-                    {"mvs/mpgc/oscillation_iteration", 12},
-                    {"mvs/global/fallback_max_baseline_deg", 30.0},
-                    {"mvs/sweep/num_views", 3},
-                    {"mvs/sweep/min_score", 0.5}});
+                    {"mvs/mpgc/min_active_views", 2},
+                    {"mvs/sweep/below_seeds", 7}});
   const DepthNodeOptions d = ReadDepthNodeOptions(p);
   EXPECT_EQ(d.world_frame, "map");
   EXPECT_DOUBLE_EQ(d.stream.keyframes.min_baseline, 0.2);
@@ -55,15 +50,11 @@ TEST(Params, ValuesReachTheCoreOptions) {
   EXPECT_FALSE(d.stream.use_tracker);
   EXPECT_EQ(d.stream.mvs.global.num_neighbors, 6);
   EXPECT_DOUBLE_EQ(d.stream.mvs.local.min_ncc, 0.35);
-  EXPECT_FALSE(d.stream.mvs.mpgc.optimize_color_scale);
+  EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.bilateral_sigma_color, 8.0);
   EXPECT_EQ(d.stream.tracker.features.max_features, 1500);
   EXPECT_DOUBLE_EQ(d.stream.store.max_mb, 128.0);
-  EXPECT_EQ(d.stream.mvs.mpgc.settle_iterations, 4);
-  EXPECT_EQ(d.stream.mvs.mpgc.full_update_interval, 3);
-  EXPECT_EQ(d.stream.mvs.mpgc.oscillation_iteration, 12);
-  EXPECT_DOUBLE_EQ(d.stream.mvs.global.fallback_max_baseline_deg, 30.0);
-  EXPECT_EQ(d.stream.mvs.sweep.num_views, 3);
-  EXPECT_DOUBLE_EQ(d.stream.mvs.sweep.min_score, 0.5);
+  EXPECT_EQ(d.stream.mvs.mpgc.min_active_views, 2);
+  EXPECT_EQ(d.stream.mvs.sweep.below_seeds, 7);
 
   MapParamSource q({{"publish_period", 0.5},
                     {"output_path", std::string("/tmp/x.ply")},
@@ -156,15 +147,13 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
 
   const std::string tuned =
       "mvs:\n"
-      "  use_color: false\n"
-      "  global: {num_neighbors: 6, fallback_max_baseline_deg: 30}\n"
-      "  rescaling: {enabled: false}\n"
-      "  local: {enabled: false, num_active: 5}\n"
-      "  mpgc: {window: 7, drop_ncc: 0.5, convergence_eps: 0.002}\n"
-      "  sweep: {step: 4, num_views: 3, min_score: 0.55}\n"
+      "  global: {num_neighbors: 6}\n"
+      "  local: {num_active: 5, min_ncc: 0.25}\n"
+      "  mpgc: {window: 7, drop_ncc: 0.5, min_active_views: 2}\n"
+      "  sweep: {below_seeds: 4}\n"
       "tracker:\n"
       "  features: {downscale: 2.0, max_features: 1234}\n"
-      "  ratio: 0.7\n";
+      "  min_track_length: 3\n";
   // The CLI's reading of the text ...
   MvsOptions mvs;
   TrackerOptions tracker;
@@ -185,9 +174,8 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
   }
   EXPECT_EQ(d.stream.mvs.mpgc.window, 7);
   EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.drop_ncc, 0.5);
-  EXPECT_FALSE(d.stream.mvs.rescaling.enabled);
-  EXPECT_FALSE(d.stream.mvs.local.enabled);
-  EXPECT_EQ(d.stream.mvs.sweep.step, 4);
+  EXPECT_DOUBLE_EQ(d.stream.mvs.local.min_ncc, 0.25);
+  EXPECT_EQ(d.stream.mvs.sweep.below_seeds, 4);
   EXPECT_DOUBLE_EQ(d.stream.tracker.features.downscale, 2.0);
 }
 
@@ -229,7 +217,7 @@ TEST(Params, BadValuesNameTheParameter) {
   // Check()'s message: the window must be odd.
   EXPECT_NE(ErrorOf(MapParamSource({{"mvs/mpgc/window", 4}})).find("odd"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(MapParamSource({{"linearize", 1}})).find("linearize"),
+  EXPECT_NE(ErrorOf(MapParamSource({{"tf_timeout", 99.0}})).find("tf_timeout"),
             std::string::npos);
   MapParamSource f({{"fusion/min_support", 0}});
   EXPECT_THROW(ReadFusionNodeOptions(f), Error);

@@ -77,7 +77,7 @@ TEST(PoseTrack, RefusesAcrossGapsAndOutsideTheSamples) {
   EXPECT_EQ(track.At(At(0.6), 0.01, 0.1, &pose), R::kAfterLast);
   EXPECT_EQ(track.At(At(-0.1), 0.01, 0.1, &pose), R::kBeforeFirst);
   EXPECT_FALSE(PoseTrack::Ok(R::kGapTooLarge));
-  EXPECT_NE(PoseTrack::Describe(R::kGapTooLarge).find("pose_max_gap"),
+  EXPECT_NE(PoseTrack::Describe(R::kGapTooLarge).find("gap"),
             std::string::npos);
 }
 

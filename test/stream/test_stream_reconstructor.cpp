@@ -504,9 +504,6 @@ TEST(StreamReconstructor, OptionsAreChecked) {
   o.worker_count = 2;
   EXPECT_THROW(o.Check(), Error);
   o = StreamOptions();
-  o.redo_min_gain = 0.5;
-  EXPECT_THROW(o.Check(), Error);
-  o = StreamOptions();
   o.max_pending = 0;
   EXPECT_THROW(StreamReconstructor(o, nullptr), Error);
 }

@@ -219,8 +219,7 @@ TEST_F(CliShard, ConcurrentShardsThenFuseEqualOneProcess) {
 TEST_F(CliShard, WithoutTheConsistencyFilterShardsWriteFinalMaps) {
   ASSERT_EQ(single_run_.status, 0) << single_run_.output;
   // Without the consistency filter: shards write final maps; 2 at once.
-  const std::string nf =
-      std::string(kStages) + " --mvs.consistency.enabled false";
+  const std::string nf = std::string(kStages) + " --ablation.consistency false";
   const RunResult single_nf = RunCli("reconstruct '" + dataset_ + "' '" +
                                          root_ + "/single_nf' --threads 2" + nf,
                                      root_ + "/single_nf.log");
@@ -250,41 +249,6 @@ TEST_F(CliShard, WithoutTheConsistencyFilterShardsWriteFinalMaps) {
   // The filter changes the maps: the comparison above is not vacuous.
   EXPECT_FALSE(ReadFile(single_ + "/depth/" + stems_[1] + ".pfm") ==
                ReadFile(root_ + "/single_nf/depth/" + stems_[1] + ".pfm"));
-}
-
-// With the second growing pass (mvs.refine, off by default): the shards
-// stop at OUT/raw as before, `fuse` filters, refines and filters again, and
-// every intermediate and final map equals one process's.
-TEST_F(CliShard, WithTheSecondPassShardsThenFuseEqualOneProcess) {
-  ASSERT_EQ(single_run_.status, 0) << single_run_.output;
-  const std::string rf = std::string(kStages) + " --mvs.refine.enabled true";
-  const RunResult single_rf = RunCli("reconstruct '" + dataset_ + "' '" +
-                                         root_ + "/single_rf' --threads 2" + rf,
-                                     root_ + "/single_rf.log");
-  const std::string sharded_rf = root_ + "/sharded_rf";
-  RunCli("reconstruct '" + dataset_ + "' '" + sharded_rf +
-             "' --threads 1 --stages sparse",
-         root_ + "/sparse_rf.log");
-  const pid_t p1 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_rf +
-                             "' --threads 1 --shard 1/2" + rf,
-                         root_ + "/shard_rf1.log");
-  const pid_t p2 = Spawn("reconstruct '" + dataset_ + "' '" + sharded_rf +
-                             "' --threads 1 --shard 2/2" + rf,
-                         root_ + "/shard_rf2.log");
-  const bool shards_ok = Wait(p1) == 0 && Wait(p2) == 0;
-  EXPECT_FALSE(fs::exists(sharded_rf + "/refined"));
-  const RunResult fuse_rf =
-      RunCli("fuse '" + sharded_rf + "' --threads 2", root_ + "/fuse_rf.log");
-  ASSERT_EQ(single_rf.status, 0) << single_rf.output;
-  ASSERT_TRUE(shards_ok) << ReadFile(root_ + "/shard_rf1.log")
-                         << ReadFile(root_ + "/shard_rf2.log");
-  ASSERT_EQ(fuse_rf.status, 0) << fuse_rf.output;
-  EXPECT_NE(fuse_rf.output.find("refine: 5 views"), std::string::npos)
-      << fuse_rf.output;
-  ExpectSameResults(root_ + "/single_rf", sharded_rf,
-                    {"depth", "normal", "confidence", "cameras", "raw/depth",
-                     "filtered1/depth", "refined/depth", "refined/normal",
-                     "refined/confidence"});
 }
 
 TEST_F(CliShard, ShardWithoutTracksOrWithOtherOptionsFailsClearly) {

@@ -115,8 +115,6 @@ TEST(FusionOptions, CheckRejectsBadValues) {
   bad([](FusionOptions& b) { b.depth_tolerance = -1; }, "depth_tolerance");
   bad([](FusionOptions& b) { b.normal_tolerance_deg = NAN; },
       "normal_tolerance_deg");
-  bad([](FusionOptions& b) { b.min_confidence = 2; }, "min_confidence");
-  bad([](FusionOptions& b) { b.cell_scale = 0; }, "cell_scale");
   bad([](FusionOptions& b) { b.bbox_min.x() = 5, b.bbox_max.x() = 1; }, "bbox");
   bad([](FusionOptions& b) { b.map_cache_mb = -1; }, "map_cache_mb");
   bad([](FusionOptions& b) { b.memory_mb = NAN; }, "memory_mb");
@@ -405,10 +403,6 @@ TEST(Fusion, MasksBoundingBoxAndConfidence) {
       FuseDepthMaps(Range(prov.n), o, prov.Get(), nullptr, half);
   EXPECT_LT(masked.size(), 0.75 * full.size());
   EXPECT_GT(masked.size(), 0.2 * full.size());
-  // Minimum confidence above the maps' 0.8 removes everything.
-  FusionOptions conf = o;
-  conf.min_confidence = 0.9;
-  EXPECT_EQ(FuseDepthMaps(Range(prov.n), conf, prov.Get()).size(), 0u);
 }
 
 // Colour comes from the image provider (linear) and is returned as sRGB;

@@ -149,7 +149,7 @@ TEST(GeometricConsistency, KeepsTrueDepthsRemovesCorruptedOnes) {
   EXPECT_GT(st.kept, 0.9 * valid);
 }
 
-TEST(GeometricConsistency, NoNeighboursOrDisabledKeepsEverything) {
+TEST(GeometricConsistency, NoNeighboursKeepsEverything) {
   const SyntheticScene& s = Scene8();
   DepthMap r = GtMap(s, 2);
   r.depth.at<float>(75, 100) *= 1.2f;
@@ -157,11 +157,6 @@ TEST(GeometricConsistency, NoNeighboursOrDisabledKeepsEverything) {
   ConsistencyStats st;
   FilterByConsistency(&r, {}, GeometricConsistencyOptions(), &st);
   EXPECT_EQ(st.kept, valid);
-  EXPECT_EQ(r.CountValid(), valid);
-  const DepthMap n = GtMap(s, 3);
-  GeometricConsistencyOptions off;
-  off.enabled = false;
-  FilterByConsistency(&r, {&n}, off, &st);
   EXPECT_EQ(r.CountValid(), valid);
   GeometricConsistencyOptions bad;
   bad.max_relative_depth = 0;

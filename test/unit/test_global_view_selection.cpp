@@ -1,13 +1,15 @@
 // Copyright wild_mvs authors. Global view selection (paper 5.1) on random
 // collections: the selection equals a straightforward implementation of the
 // paper's greedy rule (the one the library used before its per-feature
-// parallax weights were cached), bit for bit, for every reference view.
+// parallax weights were cached), bit for bit, for every reference view; and
+// on constructed cameras, the preference for parallax and resolution.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "mvs_test_scenes.h"
 #include "random_collection.h"
 #include "wild_mvs/core/global_view_selection.h"
 #include "wild_mvs/core/stats.h"
@@ -181,6 +183,63 @@ TEST(GlobalViewSelection, DuplicateObservationsAndViewsBehindCount) {
     scene.points[p].track.push_back(o);
   }
   ExpectSameSelections(scene, GlobalViewSelectionOptions());
+}
+
+// Constructed cameras on a circle around the origin: the selection prefers
+// parallax (not the twin next to R) and matching resolution.
+TEST(MvsGlobalViewSelection, PrefersParallaxAndMatchingResolution) {
+  Scene scene;
+  auto add = [&](const char* name, const Camera& cam) {
+    View v;
+    v.name = name;
+    v.camera = cam;
+    scene.views.push_back(v);
+  };
+  const Eigen::Vector3d o(0, 0, 0);
+  add("ref",
+      testing::LookAtCamera(testing::OnCircle(0, 4), o, 400, 320, 240));  // 0
+  add("twin",
+      testing::LookAtCamera(testing::OnCircle(0.2, 4), o, 400, 320, 240));  // 1
+  add("good_left",
+      testing::LookAtCamera(testing::OnCircle(-15, 4), o, 400, 320, 240));  // 2
+  add("far_lowres",
+      testing::LookAtCamera(testing::OnCircle(13, 4), o, 100, 80, 60));  // 3
+  add("good_right",
+      testing::LookAtCamera(testing::OnCircle(16, 4), o, 400, 320, 240));  // 4
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  for (int i = 0; i < 200; ++i) {
+    SparsePoint p;
+    p.xyz = Eigen::Vector3d(u(rng), 0.5 * u(rng), u(rng));
+    for (int v = 0; v < 5; ++v) {
+      Eigen::Vector2d px;
+      ASSERT_TRUE(scene.views[v].camera.Project(p.xyz, &px));
+      Observation ob;
+      ob.view = v;
+      ob.xy = px;
+      ob.scale = 2;
+      p.track.push_back(ob);
+    }
+    scene.points.push_back(p);
+  }
+  const auto ppv = scene.PointsPerView();
+  const GlobalViewSelection sel =
+      SelectGlobalViews(scene, 0, ppv, GlobalViewSelectionOptions());
+  ASSERT_GE(sel.neighbors.size(), 2u);
+  EXPECT_TRUE(sel.fallbacks.empty());
+  for (size_t i = 0; i < sel.neighbors.size(); ++i)
+    std::printf("neighbour %zu: %s score %.2f\n", i,
+                scene.views[sel.neighbors[i]].name.c_str(), sel.scores[i]);
+  // The good cameras rank first (in either order), the twin never enters.
+  const std::vector<int> first(sel.neighbors.begin(),
+                               sel.neighbors.begin() + 2);
+  EXPECT_TRUE(std::count(first.begin(), first.end(), 2) == 1 &&
+              std::count(first.begin(), first.end(), 4) == 1);
+  EXPECT_EQ(std::count(sel.neighbors.begin(), sel.neighbors.end(), 1), 0);
+  // If the low-resolution camera enters, it scores below the good ones.
+  for (size_t i = 2; i < sel.neighbors.size(); ++i)
+    EXPECT_LT(sel.scores[i], 0.5 * sel.scores[1]);
+  EXPECT_GT(sel.scores[0], 0);
 }
 
 }  // namespace

@@ -68,7 +68,7 @@ TEST(MeshingOptions, CheckRejectsBadValues) {
   o.trim_distance = -1;
   EXPECT_THROW(o.Check(), Error);
   o = MeshingOptions();
-  o.point_weight = NAN;
+  o.trim_distance = NAN;
   EXPECT_THROW(o.Check(), Error);
   o = MeshingOptions();
   o.decimation_cell = -0.1;

@@ -232,22 +232,22 @@ TEST_F(MvsEndToEnd, Ablations) {
   Print("paper preset", def);
 
   MvsOptions no_local = paper;
-  no_local.local.enabled = false;
+  no_local.ablation.local_view_selection = false;
   const DepthScore nl = Score(s, Run(s, ref, no_local, 2, &rep), 0.01);
   Print("no local view selection", nl);
 
   MvsOptions no_normal = paper;
-  no_normal.mpgc.optimize_normal = false;
+  no_normal.ablation.optimize_normal = false;
   const DepthScore nn = Score(s, Run(s, ref, no_normal, 2, &rep), 0.01);
   Print("no normal optimisation", nn);
 
   MvsOptions fixed_scale = paper;
-  fixed_scale.mpgc.optimize_color_scale = false;
+  fixed_scale.ablation.optimize_color_scale = false;
   const DepthScore fs = Score(s, Run(s, ref, fixed_scale, 2, &rep), 0.01);
   Print("colour scale fixed", fs);
 
   MvsOptions grey = paper;
-  grey.use_color = false;
+  grey.ablation.color = false;
   const DepthScore gr = Score(s, Run(s, ref, grey, 2, &rep), 0.01);
   Print("grey", gr);
 

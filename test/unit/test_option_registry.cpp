@@ -19,27 +19,14 @@ TEST(OptionRegistry, StructNestingGivesTheKeys) {
   cli::ReconstructConfig c;
   OptionRegistry r;
   cli::RegisterOptions(&c, &r);
-  for (const char* key : {"run.threads",
-                          "image.cache_mb",
-                          "tracker.features.downscale",
-                          "tracker.max_neighbors",
-                          "mvs.use_color",
-                          "mvs.global.num_neighbors",
-                          "mvs.global.fallback_max_baseline_deg",
-                          "mvs.rescaling.enabled",
-                          "mvs.local.enabled",
-                          "mvs.mpgc.window",
-                          "mvs.mpgc.drop_ncc",
-                          "mvs.mpgc.settle_iterations",
-                          "mvs.mpgc.full_update_interval",
-                          "mvs.mpgc.oscillation_iteration",
-                          "mvs.growing.revisit_margin",
-                          "mvs.sweep.step",
-                          "mvs.sweep.num_views",
-                          "mvs.sweep.min_score",
-                          "fusion.bbox_min_x",
-                          "fusion.pending_mb",
-                          "meshing.depth"}) {
+  for (const char* key :
+       {"run.threads", "image.cache_mb", "tracker.features.downscale",
+        "tracker.max_neighbors", "mvs.global.num_neighbors",
+        "mvs.local.num_active", "mvs.mpgc.window", "mvs.mpgc.drop_ncc",
+        "mvs.growing.revisit_margin", "mvs.sweep.below_seeds",
+        "consistency.min_consistent", "ablation.color",
+        "ablation.local_view_selection", "ablation.consistency",
+        "fusion.bbox_min_x", "fusion.pending_mb", "meshing.depth"}) {
     EXPECT_TRUE(r.Has(key)) << key;
   }
   // Each key points at its field.
@@ -49,8 +36,10 @@ TEST(OptionRegistry, StructNestingGivesTheKeys) {
   EXPECT_EQ(c.mvs.mpgc.window, 7);
   r.Find("tracker.features.downscale")->SetInt(2);  // int for a double
   EXPECT_DOUBLE_EQ(c.tracker.features.downscale, 2.0);
-  r.Find("mvs.local.enabled")->SetBool(false);
-  EXPECT_FALSE(c.mvs.local.enabled);
+  r.Find("ablation.local_view_selection")->SetBool(false);
+  EXPECT_FALSE(c.mvs.ablation.local_view_selection);
+  r.Find("ablation.linearize")->SetBool(false);
+  EXPECT_FALSE(c.LoaderOptions().linearize);
   r.Find("run.stages")->SetString("depth");
   EXPECT_EQ(c.run.stages, "depth");
   // Every key is unique and every option has help.

@@ -418,24 +418,21 @@ TEST(SparseTracker, EpipolarGateRejectsWrongPose) {
 }
 
 // Matches whose features differ in world size (SIFT scale x pixel
-// footprint) by more than max_scale_ratio are rejected.
+// footprint) by more than a factor 1.8 are rejected.
 TEST(SparseTracker, ScaleConsistencyFilter) {
   FeatureWorld w = MakeWorld(2, 20, 400, 0.0, 12);
-  auto count = [&w](double factor, double max_ratio) {
+  auto count = [&w](double factor) {
     Features f1 = w.features[1];
     for (float& s : f1.scale) s *= static_cast<float>(factor);
-    TrackerOptions opt;
-    opt.max_scale_ratio = max_ratio;
-    SparseTracker t(opt);
+    SparseTracker t{TrackerOptions()};
     t.AddView(0, w.cameras[0], w.features[0]);
     t.AddView(1, w.cameras[1], f1);
     return t.Points().size();
   };
-  const size_t base = count(1.0, 1.8);
+  const size_t base = count(1.0);
   EXPECT_GT(base, 200u);
-  EXPECT_NEAR(static_cast<double>(count(1.3, 1.8)), base, 0.1 * base);
-  EXPECT_EQ(count(2.5, 1.8), 0u);
-  EXPECT_EQ(count(2.5, 0), base);  // filter off
+  EXPECT_NEAR(static_cast<double>(count(1.3)), base, 0.1 * base);
+  EXPECT_EQ(count(2.5), 0u);
 }
 
 TEST(SparseTracker, FillSceneChecksViewIndices) {
@@ -465,14 +462,11 @@ TEST(SparseTracker, OptionsCheckNamesTheOption) {
   };
   TrackerOptions o;
   EXPECT_NO_THROW(o.Check());
-  o.ratio = 1.5;
-  expect_bad(o, "ratio");
-  o = TrackerOptions();
   o.max_neighbors = 0;
   expect_bad(o, "max_neighbors");
   o = TrackerOptions();
-  o.max_epipolar_distance = -1;
-  expect_bad(o, "max_epipolar_distance");
+  o.max_reprojection_error = 0;
+  expect_bad(o, "max_reprojection_error");
   o = TrackerOptions();
   o.min_track_length = 1;
   expect_bad(o, "min_track_length");

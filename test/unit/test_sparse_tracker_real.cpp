@@ -75,30 +75,6 @@ TEST(SparseTrackerReal, TempleSparseRing) {
     xyz.push_back({p.xyz.x(), p.xyz.y(), p.xyz.z()});
   std::sort(xyz.begin(), xyz.end());
   EXPECT_EQ(std::adjacent_find(xyz.begin(), xyz.end()), xyz.end());
-
-  // Resolving conflicting tracks instead of rejecting them keeps more
-  // points, still within the error bound.
-  TrackerOptions resolve = opt;
-  resolve.resolve_conflicts = true;
-  TrackerStats rstats;
-  const std::vector<SparsePoint> rpts =
-      ComputeSparseTracks(scene, cache, resolve, &pool, &rstats);
-  std::vector<double> rerrors;
-  for (const SparsePoint& p : rpts) {
-    for (const Observation& o : p.track) {
-      const Camera& c = scene.views[o.view].camera;
-      ASSERT_GT(c.Depth(p.xyz), 0);
-      rerrors.push_back(ReprojectionError(c, p.xyz, o.xy));
-      ASSERT_LE(rerrors.back(), opt.max_reprojection_error + 1e-9);
-    }
-  }
-  std::sort(rerrors.begin(), rerrors.end());
-  std::cout << "with resolve_conflicts: " << rpts.size() << " points ("
-            << rstats.conflicting_tracks << " conflicting tracks), median "
-            << rerrors[rerrors.size() / 2] << " px" << std::endl;
-  EXPECT_GT(rstats.conflicting_tracks, 0);
-  EXPECT_GT(rpts.size(), pts.size());
-  EXPECT_LT(rerrors[rerrors.size() / 2], 0.5);
 }
 
 }  // namespace

@@ -6,8 +6,10 @@
 //   image.*    ImageOptions (image loading and cache)
 //   tracker.*  TrackerOptions (sparse tracks from known poses;
 //              tracker.features.* its FeatureOptions)
-//   mvs.*      MvsOptions (mvs.global, mvs.rescaling, mvs.local, mvs.mpgc,
-//              mvs.growing, mvs.sweep: the per-view depth map)
+//   mvs.*      MvsOptions (mvs.global, mvs.local, mvs.mpgc, mvs.growing,
+//              mvs.sweep, mvs.consistency: the per-view depth maps)
+//   ablation.* AblationOptions (MvsOptions::ablation: parts of the method
+//              turned off for experiments; not read by the ROS nodes)
 //   fusion.*   FusionOptions (consistency-checked fusion)
 //   meshing.*  MeshingOptions (screened Poisson, trimming, decimation)
 // Keys are the C++ member names, so the headers document them; each struct
@@ -55,6 +57,12 @@ struct ReconstructConfig {
   MeshingOptions mesh;
   // Runs every struct's Check() (errors name section.key and the value).
   void Check() const;
+  // The image loader's options: image.* with mvs.ablation.linearize.
+  ImageOptions LoaderOptions() const {
+    ImageOptions o = image;
+    o.linearize = mvs.ablation.linearize;
+    return o;
+  }
 };
 
 // Registers every field of `config` under its section.key.

@@ -53,7 +53,7 @@ bool ViewOutputsComplete(const std::string& out, const std::string& stem);
 // writes depth/normal/confidence/cameras/preview files and log/S.json. A
 // view that fails (bad image, ...) is reported in `failures` and the others
 // go on; output write errors abort (Error). With the consistency filter
-// (mvs.consistency.enabled) the MVS maps go to OUT/raw and, when
+// (ablation.consistency) the MVS maps go to OUT/raw and, when
 // `filter_now`, are filtered into OUT at the end; otherwise (a shard, which
 // lacks its neighbours' maps) they stay in OUT/raw for FilterPendingViews.
 DepthStageResult RunDepthStage(
@@ -71,50 +71,20 @@ struct FilterStageResult {
 // layout of depth_map_io.h, with log/S.json), writes the filtered map and
 // its log (with a "consistency" member) to `out`. Views run in parallel on
 // `pool` (may be null); files are written in order, atomically.
-// `member`: the log's key for the filter's counts. `earlier` (a folder,
-// "" = none): each view's earlier map there; samples that differ from it
-// need min_consistent_new confirmations (FilterByConsistency).
-FilterStageResult FilterDepthMaps(
-    const Scene& scene, const std::vector<int>& views,
-    const GeometricConsistencyOptions& options, const std::string& raw,
-    const std::string& out, ThreadPool* pool, std::ostream& log,
-    const std::string& member = "consistency", const std::string& earlier = "",
-    int min_consistent_new = 0);
-
-struct RefineStageResult {
-  int refined = 0;
-  long long samples_before = 0, samples = 0;
-  std::vector<std::string> failures;
-};
-// The second growing pass (RefineView, core/view_refinement.h) of `views`,
-// in order: reads each view's filtered map and its neighbours' from `in`,
-// writes the grown map and its log (with a "refinement" member) to `out`.
-RefineStageResult RefineDepthMaps(
-    const Scene& scene, const std::vector<int>& views, ImageCache& images,
-    const MvsOptions& mvs, const std::string& in, const std::string& out,
-    ThreadPool* pool, std::ostream& log,
-    const std::vector<std::vector<int>>* points_per_view = nullptr);
-
-// What follows the first pass for `views` (their maps in OUT/raw): the
-// consistency filter into OUT; with mvs.refine.enabled, the filter into
-// OUT/filtered1, the second pass into OUT/refined (from the OUT/filtered1
-// maps of the view and its neighbours) and the filter of those into OUT.
-// Each step skips the views whose output of that step is complete
-// (resumable; every step of every view runs before the next step, so the
-// result does not depend on how the first pass was split into shards).
-// The counts returned are those of the last filter (failures of every step).
-FilterStageResult FinishDepthMaps(
-    const Scene& scene, const std::vector<int>& views, ImageCache& images,
-    const MvsOptions& mvs, ThreadPool* pool, const std::string& out,
-    std::ostream& log,
-    const std::vector<std::vector<int>>* points_per_view = nullptr);
+// `member`: the log's key for the filter's counts.
+FilterStageResult FilterDepthMaps(const Scene& scene,
+                                  const std::vector<int>& views,
+                                  const GeometricConsistencyOptions& options,
+                                  const std::string& raw,
+                                  const std::string& out, ThreadPool* pool,
+                                  std::ostream& log,
+                                  const std::string& member = "consistency");
 
 // The views of `scene` with a complete raw map in OUT/raw but no complete
-// final map in OUT (left by --shard runs), finished with FinishDepthMaps
-// (filter, and the second pass when enabled) into OUT; nothing when the
-// filter is disabled. Throws Error listing the views that failed.
-FilterStageResult FilterPendingViews(const Scene& scene, ImageCache& images,
-                                     const MvsOptions& mvs,
+// final map in OUT (left by --shard runs), filtered (FilterDepthMaps) into
+// OUT; nothing when the filter is off (AblationOptions::consistency). Throws
+// Error listing the views that failed.
+FilterStageResult FilterPendingViews(const Scene& scene, const MvsOptions& mvs,
                                      const std::string& out, ThreadPool* pool,
                                      std::ostream& log);
 

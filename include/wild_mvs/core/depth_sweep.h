@@ -14,13 +14,8 @@
 namespace wild_mvs {
 
 struct DepthSweepOptions {
-  int step = 8;            // (choice) test every step-th pixel on a grid
-  int num_depths = 64;     // (choice) depths, uniform in 1/z over the range
-  int num_views = 2;       // (choice) score = mean of the best k NCCs
-  double min_score = 0.6;  // (choice) seed only above this mean NCC
-  // (choice) The sweep seeds the pixels still empty also when fewer than
-  // this many sparse features matched (views with few features: internet
-  // photos of plain walls, fast robot motion); 0 = only when none matched.
+  // The sweep seeds the pixels still empty also when fewer than this many
+  // sparse features matched, >= 0; 0 = only when none matched.
   int below_seeds = 20;
   void Check() const;
 };

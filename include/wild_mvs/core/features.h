@@ -23,15 +23,6 @@ struct FeatureOptions {
   // Keep at most this many features per view (strongest response first);
   // bounds memory (128 bytes per descriptor) and matching time. 0 = no cap.
   int max_features = 4000;
-  // OpenCV SIFT contrastThreshold (OpenCV's default 0.04; lower finds more
-  // features on weakly textured objects such as the Middlebury plaster
-  // models).
-  double contrast_threshold = 0.02;
-  // OpenCV SIFT edgeThreshold (OpenCV default).
-  double edge_threshold = 10;
-  // OpenCV SIFT nOctaveLayers and sigma (Lowe's values).
-  int octave_layers = 3;
-  double sigma = 1.6;
   // Features are detected on the image shrunk by this factor (>= 1) when
   // views are large; positions and scales are reported in full-resolution
   // pixels.
@@ -40,12 +31,6 @@ struct FeatureOptions {
   // photos: SIFT time grows with the pixel count while the extra
   // features of a 6-megapixel image rarely help); 0 = no limit.
   int max_image_size = 2000;
-  // Images inside the core are linear; SIFT's thresholds are tuned for
-  // display-encoded images, so the grey image is sRGB-encoded first.
-  bool srgb_encode = true;
-  // RootSIFT descriptors (Arandjelovic & Zisserman 2012: L1-normalise, square
-  // root), which match better than plain SIFT under the L2 distance.
-  bool root_sift = true;
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h), e.g.

@@ -3,8 +3,8 @@
 // bounded memory.
 //
 // Algorithm (docs/ALGORITHM.md section 6; the check COLMAP and OpenMVS use):
-//  - A depth sample of view v (pixel with depth > 0, confidence >=
-//    min_confidence, not masked, inside the bounding box) is back-projected
+//  - A depth sample of view v (pixel with depth > 0 and a finite
+//    confidence, not masked, inside the bounding box) is back-projected
 //    to a world point X with world normal N. It is checked against every
 //    related view u (below): X is projected into u; u's depth d_u at that
 //    pixel must agree with X's depth z_u in u (|d_u - z_u| <= depth_tolerance
@@ -13,7 +13,7 @@
 //    normal_tolerance_deg of N. support = 1 + number of agreeing views.
 //  - A sample with support >= min_support is accepted and merged into the
 //    cloud through a scale-adaptive spatial hash: cells of size
-//    cell_scale * (pixel footprint at the sample's depth), on power-of-two
+//    kCellScale * (pixel footprint at the sample's depth), on power-of-two
 //    levels; a sample joins an existing point of its level or the two
 //    adjacent levels when it lies within that radius and the normals agree,
 //    else it starts a new point. Points hold the confidence-weighted mean of
@@ -23,7 +23,7 @@
 // Related views of v: the views in v's DepthMap::neighbors plus the views
 // that list v as a neighbour, among the views added so far; when a map has
 // no neighbours, the views whose cameras see most of v's samples (overlap,
-// up to max_neighbors).
+// up to kMaxRelatedViews).
 //
 // Streaming and incremental (AddView): depth maps come from a provider
 // callback and are held in an LRU bounded by map_cache_mb, so memory does not
@@ -65,13 +65,18 @@
 
 namespace wild_mvs {
 
+// Merge radius / hash cell size as a multiple of the pixel footprint at the
+// sample's depth.
+constexpr double kCellScale = 1.0;
+// Related views per view when they come from camera overlap (maps without
+// neighbours) and the cap on related views in general.
+constexpr int kMaxRelatedViews = 12;
+
 struct FusionOptions {
   // Minimum number of views (the sample's own view included) whose depth
   // maps agree with a sample for it to be kept (COLMAP's min_num_pixels
   // counts the same way).
   int min_support = 3;
-  // Samples with confidence below this are ignored (also as supporters).
-  double min_confidence = 0.0;
   // Relative depth tolerance of the consistency check |d_u - z_u| / z_u
   // (COLMAP max_depth_error = 0.01).
   double depth_tolerance = 0.01;
@@ -82,12 +87,6 @@ struct FusionOptions {
   // (COLMAP max_normal_error = 10; MVS normals are noisier, hence 20). Also
   // used when merging samples into one point.
   double normal_tolerance_deg = 20.0;
-  // Merge radius / hash cell size as a multiple of the pixel footprint at
-  // the sample's depth.
-  double cell_scale = 1.0;
-  // Related views per view when they come from camera overlap (maps without
-  // neighbours) and the cap on related views in general.
-  int max_neighbors = 12;
   // Bounding box in world units; samples outside are ignored. Default: none.
   Eigen::Vector3d bbox_min =
       Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());

@@ -31,23 +31,16 @@
 namespace wild_mvs {
 
 struct GeometricConsistencyOptions {
-  bool enabled = true;  // false = keep every sample (the paper)
-  // Neighbours that must confirm a sample (COLMAP: 2 of its sources;
-  // OpenMVS: 2 views in all).
-  int min_consistent = 1;
-  double max_reprojection_px = 1.0;  // forward-backward distance in R
-  double max_relative_depth = 0.01;  // |z' - z| / z
-  // Pixels of V tried around the one containing q: 0 = that pixel only; 1 =
-  // its 3x3 neighbourhood (any of them confirming is enough), which forgives
-  // holes in V's map and the up to 0.7 px between q and the centre of the
-  // pixel containing it.
-  int search_px = 1;
-  // Free-space violations counted beyond this relative depth; a sample
-  // needs confirmations >= violations. -1 = not counted (confirmations
-  // only). With search_px 1 (measured, docs/EVALUATION.md): fountain-P11
-  // covers 2.5 points more at the same accuracy, with fewer background
-  // estimates; the rendered scenes gain 0.001-0.002 of completeness.
+  int min_consistent = 1;  // neighbours that must confirm a sample, [1, 32]
+  double max_reprojection_px = 1.0;  // forward-backward distance in R, px
+  double max_relative_depth = 0.01;  // |z' - z| / z, (0, 1)
+  // Free-space violations counted beyond this relative depth, [0, 1); a
+  // sample needs confirmations >= violations. -1 = not counted.
   double free_space_margin = 0.01;
+  // Pixels of V tried around the one containing q, [0, 3] (not registered;
+  // tests vary it): 0 = that pixel only; 1 = its 3x3 neighbourhood (any of
+  // them confirming is enough).
+  int search_px = 1;
   void Check() const;
 };
 
@@ -72,18 +65,12 @@ cv::Mat CountConsistentViews(const DepthMap& ref,
 
 // Removes the samples of *ref (depth, normal and confidence set to 0) that
 // fewer than options.min_consistent of `neighbors` confirm, or (with
-// free_space_margin >= 0) that more neighbours see through than confirm. No-op
-// when disabled or when no neighbour map is given (nothing to check against:
+// free_space_margin >= 0) that more neighbours see through than confirm.
+// No-op when no neighbour map is given (nothing to check against:
 // stats->kept = samples).
-// earlier (CV_32F of ref's size, may be empty): an earlier map of the same
-// view (the second pass's start, view_refinement.h); the samples of *ref
-// that differ from it (new or changed) need max(min_consistent,
-// min_consistent_new) confirmations instead.
 void FilterByConsistency(DepthMap* ref,
                          const std::vector<const DepthMap*>& neighbors,
                          const GeometricConsistencyOptions& options,
-                         ConsistencyStats* stats,
-                         const cv::Mat& earlier = cv::Mat(),
-                         int min_consistent_new = 0);
+                         ConsistencyStats* stats);
 
 }  // namespace wild_mvs

@@ -12,15 +12,14 @@
 namespace wild_mvs {
 
 struct GlobalViewSelectionOptions {
-  int num_neighbors = 10;        // |N| (paper: 10)
-  double max_parallax_deg = 10;  // a_max of the parallax weight (paper: 10)
-  // (choice, not in the paper) A candidate whose median triangulation angle
-  // with R over the shared features (or at the scene, for the fallback) is
-  // below this never enters N: views taken from the same position (twins)
-  // add no depth information and poison the active set.
+  int num_neighbors = 10;  // |N|, [1, 32] (paper: 10)
+  // Not registered (the paper's and our fixed values; tests vary them):
+  // max_parallax_deg, a_max of the parallax weight (paper: 10); a candidate
+  // whose median triangulation angle with R is below min_baseline_deg
+  // never enters N (twins add no depth information); the fallback without
+  // shared features accepts at most fallback_max_baseline_deg.
+  double max_parallax_deg = 10;
   double min_baseline_deg = 2.5;
-  // (choice) Fallback when R shares no feature with any view: at most this
-  // triangulation angle for a frustum-overlap neighbour.
   double fallback_max_baseline_deg = 45;
   void Check() const;
 };

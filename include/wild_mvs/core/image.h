@@ -24,7 +24,8 @@ namespace wild_mvs {
 
 struct ImageOptions {
   // Apply the inverse sRGB transfer function at load (the paper matches in
-  // linear radiometric space).
+  // linear radiometric space). Not registered: the command line sets it from
+  // ablation.linearize (AblationOptions).
   bool linearize = true;
   // Budget of the image cache in megabytes; least recently used images are
   // evicted beyond it, so memory does not grow with the number of views.

@@ -10,15 +10,14 @@
 
 namespace wild_mvs {
 
+// g_max, the epipolar-angle spread in degrees (paper: 10).
+constexpr double kMaxEpipolarAngleDeg = 10;
+
 struct LocalViewSelectionOptions {
-  // false = the paper's "no local view selection" ablation: the best m views
-  // of the global selection, always the same, no refill.
-  bool enabled = true;
-  int num_active = 4;                  // m = |A| (paper: 4)
-  double max_epipolar_angle_deg = 10;  // g_max (paper: 10)
-  double min_ncc = 0.3;                // NCC to enter A (paper: 0.3)
-  // min_ncc where the window is wide (MpgcOptions::wide_drop_ncc, measured
-  // with it); < -1 = min_ncc.
+  int num_active = 4;    // m = |A|, [1, 8] (paper: 4)
+  double min_ncc = 0.3;  // NCC to enter A, [-1, 1] (paper: 0.3)
+  // min_ncc where the window is wide (MpgcOptions::wide_drop_ncc), [-2, 1];
+  // < -1 = min_ncc.
   double wide_min_ncc = 0.12;
   void Check() const;
 };
@@ -45,11 +44,12 @@ int PickNextView(int num_views, const double* global_scores,
                  const int* active, int num_active, double max_angle_rad);
 
 // The admission test: a candidate whose patch NCC with R is below min_ncc
-// does not enter A. Without local view selection (enabled = false, the
-// ablation) every view that could be sampled enters. A NaN NCC is not below
-// min_ncc.
-inline bool AdmitsView(const LocalViewSelectionOptions& options, double ncc) {
-  return !options.enabled || !(ncc < options.min_ncc);
+// does not enter A. Without local view selection (select = false, the
+// ablation AblationOptions::local_view_selection) every view that could be
+// sampled enters. A NaN NCC is not below min_ncc.
+inline bool AdmitsView(const LocalViewSelectionOptions& options, bool select,
+                       double ncc) {
+  return !select || !(ncc < options.min_ncc);
 }
 
 // Candidate states in `state` (indices into the candidate arrays).
@@ -58,16 +58,16 @@ constexpr uint8_t kCandidateUntried = 0, kCandidateActive = 1,
 
 // The fill loop of local view selection: while A (active[0, *num_active))
 // holds fewer than options.num_active views, picks the next candidate with
-// PickNextView and tries it. sample(v, &ncc) prepares candidate v, returns
-// false when its patch cannot be sampled and else sets ncc, its NCC with R.
-// A candidate that cannot be sampled or fails AdmitsView is rejected
-// (state kCandidateRejected, then refuse(v)); one that passes gets
+// PickNextView and tries it (select: AdmitsView). sample(v, &ncc) prepares
+// candidate v, returns false when its patch cannot be sampled and else sets
+// ncc, its NCC with R. A candidate that cannot be sampled or fails AdmitsView
+// is rejected (state kCandidateRejected, then refuse(v)); one that passes gets
 // enter(v, ncc, a) with a its index in A (before active[a] = v, state
 // kCandidateActive and ++*num_active). Returns the number of views that
 // entered.
 template <typename Sample, typename Enter, typename Refuse>
-int FillActiveSet(const LocalViewSelectionOptions& options, int num_views,
-                  const double* global_scores,
+int FillActiveSet(const LocalViewSelectionOptions& options, bool select,
+                  int num_views, const double* global_scores,
                   const Eigen::Vector2d* directions, double max_angle_rad,
                   uint8_t* state, int* active, int* num_active, Sample&& sample,
                   Enter&& enter, Refuse&& refuse) {
@@ -77,7 +77,7 @@ int FillActiveSet(const LocalViewSelectionOptions& options, int num_views,
                                active, *num_active, max_angle_rad);
     if (v < 0) break;
     double ncc = 0;
-    if (!sample(v, &ncc) || !AdmitsView(options, ncc)) {
+    if (!sample(v, &ncc) || !AdmitsView(options, select, ncc)) {
       state[v] = kCandidateRejected;
       refuse(v);
       continue;

@@ -23,18 +23,9 @@ struct MeshingOptions {
   // Maximum octree depth of the Poisson solve (resolution 2^depth over the
   // bounding cube); the solver adapts below it.
   int depth = 9;
-  // Screening weight of the point interpolation (screened Poisson, Kazhdan
-  // and Hoppe 2013; 4 is PoissonRecon's default; 0 = unscreened).
-  double point_weight = 4.0;
-  // Minimum samples per octree node (1-5 for clean data, 15-20 for noisy).
-  double samples_per_node = 1.5;
-  // Ratio of the reconstruction cube to the samples' bounding cube.
-  double scale = 1.1;
   // Trim: remove vertices farther than trim_distance x local sample spacing
   // from the nearest sample. 0 = no trimming.
   double trim_distance = 2.0;
-  // Neighbours whose mean distance defines the local sample spacing.
-  int spacing_neighbors = 8;
   // Drop connected components with fewer faces after trimming.
   int min_component_faces = 50;
   // Vertex-clustering decimation cell in world units; 0 = off.

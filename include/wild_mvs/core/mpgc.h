@@ -26,112 +26,47 @@ constexpr int kWideWindowFromPx = 1200;
 // it is > 0, else 1 or 2 by the longer side (kWideWindowFromPx).
 int AutoWindowStep(int step, int width, int height);
 
+// The paper's schedule (section 6.2), fixed: tests substitute other values
+// to observe its rules one by one.
+struct MpgcSchedule {
+  int settle_iterations = 5;       // iterations before any test
+  double convergence_eps = 1e-3;   // converged when every NCC moves less
+  int max_iterations = 20;         // fail after
+  int full_update_interval = 5;    // normal + colour scales every k-th
+                                   // iteration (or after A changed)
+  int oscillation_iteration = 14;  // once: drop views whose NCC still moves
+                                   // (0 = never)
+};
+// normal . (-ray) must exceed this (paper: 0.1).
+constexpr double kMinFacing = 0.1;
+
 struct MpgcOptions {
-  int window = 5;  // n of the n x n window (paper: 5)
-  // (beyond the paper, as OpenMVS samples its windows) Pixels between the
-  // window's samples: the n x n samples cover (n - 1) * step + 1 pixels of
-  // R, a wider footprint at the cost of n x n (paper: 1). 0 = by R's working
-  // size (AutoWindowStep): 1 below kWideWindowFromPx on the longer side, 2
-  // from there (measured, docs/EVALUATION.md: fountain-P11 at 1536 px
-  // covers 3 points more with step 2; 640 px scenes lose 0.02 with it).
+  int window = 5;  // n of the n x n window, odd, [3, kMaxWindow] (paper: 5)
+  // Pixels between the window's samples, [0, 4] (paper: 1); 0 = by R's
+  // working size (AutoWindowStep).
   int window_step = 0;
-  int settle_iterations = 5;  // iterations before any test (paper: 5)
-  double drop_ncc = 0.4;      // kappa: drop views below (paper: 0.4)
-  // (beyond the paper) kappa where the window is wide (window step >= 2:
-  // AutoWindowStep's choice from kWideWindowFromPx, or an explicit step);
-  // < -1 = drop_ncc. With the bilateral window a lower kappa spends its
-  // accuracy on coverage there (measured, docs/EVALUATION.md, "Bilateral
-  // window": fountain-P11 at 1536 px, colour sigma 10, kappa 0.4 / 0.3 /
-  // 0.25 / 0.2: 88.3 / 89.6 / 89.8 / 90.0 % coverage at 97.7 to 97.3 %
-  // within 1 %; 0.22 with the defaults: 90.1 % at 97.2 %), while at 640 px
-  // it costs speed and gross errors (templeSparseRing -17 % correct per
-  // CPU-s, the rendered clutter scene 1.05 % off by more than 5 %).
+  double drop_ncc = 0.4;  // kappa: drop active views below, [-1, 1]
+  // kappa where the window is wide (step >= 2), [-2, 1]; < -1 = drop_ncc.
   double wide_drop_ncc = 0.22;
-  double convergence_eps = 1e-3;   // eps on every NCC change (paper: 0.001)
-  int max_iterations = 20;         // fail after (paper: 20)
-  int full_update_interval = 5;    // normal + colour scales at every k-th
-                                   // iteration (k, 2k, ... counted from 1)
-                                   // or after a change of A (paper: 5)
-  int oscillation_iteration = 14;  // once, after this iteration, drop views
-                                   // whose NCC changed by more than eps
-                                   // (paper: 14); 0 = never
-  double min_facing = 0.1;         // normal . (-ray) must exceed (paper: 0.1)
-  // (choice: the paper says "the required number of views"; MVE: 4 = m)
-  // Fail when fewer active views remain.
-  int min_active_views = 3;
-  // (beyond the paper; MVE's dmrecon: 0.6) Accept a converged match only
-  // when the mean NCC over A reaches this; -1 = accept any (paper).
-  double accept_ncc = -1;
-  // (beyond the paper) The reference must be explained: a converged match
-  // is unexplained when the best NCC of an active view with R falls more
-  // than this below the active views' mean NCC with each other. There the
-  // views agree about a surface that R's window does not show (R alone sees
-  // a transient occluder in front of it, the neighbours the background
-  // behind it; docs/EVALUATION.md, "One-view occluders"). -1 = off (paper).
+  int min_active_views = 3;  // fail with fewer active views, [1, kMaxActive]
+  // A converged match is unexplained when the best NCC of an active view
+  // with R is more than this below the active views' mean NCC with each
+  // other, [0, 2]; -1 = off (paper).
   double explain_margin = 0;
-  // Only matches whose mean NCC with R is below this are tested (a window
-  // that R's views explain this well is not the wrong surface); > 1 = all.
+  // Only matches whose mean NCC with R is below this are tested, [-1, 1.5].
   double explain_below_ncc = 0.8;
-  // What an unexplained match does: false = it fails (no depth); true = it
-  // keeps its depth but is marked unexplained (PatchResult::explained), and
-  // region growing does not expand from it, so the background cannot
-  // percolate through a one-view occluder while a weak but right match
-  // still counts. Measured (docs/EVALUATION.md): clutter's gross errors
-  // 1.94 -> 0.95 % at the same completeness; fountain-P11 -0.6 points of
-  // coverage (failing the match instead: -1.2 to -2.5).
+  // An unexplained match keeps its depth but is not expanded from
+  // (PatchResult::explained); false = it fails.
   bool explain_keeps_match = true;
-  // (beyond the paper) A reference window whose intensity spread is below
-  // this many 8-bit sRGB levels (standard deviation, mean over channels) is
-  // not matched: sky, saturated or blank walls, where NCC is noise. 0 =
-  // only the numerical floor (paper).
-  double min_texture_levels = 0;
-  // (beyond the paper, as COLMAP's patch-match stereo weights its NCC)
-  // Bilateral window: each window sample is weighted by its closeness to
-  // the centre in R, exp(-d^2 / 2 sigma_space^2) with d in window samples,
-  // and in colour, exp(-dc^2 / 2 sigma_color^2) with dc the RMS over
-  // channels of the difference from the centre pixel in 8-bit levels of a
-  // gamma-2 encoding (255 sqrt(I) of the linear intensity I), so that
-  // pixels of another surface across a depth edge count less. Every NCC,
-  // mean and least-squares sum of MPGC is then weighted; the texture test
-  // above stays unweighted. 0 = off: every sample weighs 1 (paper).
-  // Measured (docs/EVALUATION.md, "Bilateral window"): fountain-P11 within
-  // 1 % 96.97 -> 97.74 % at sigma 10; the rendered scenes' gross errors
-  // more than halved.
+  // Bilateral window weights: exp(-d^2 / 2 sigma_space^2), d in window
+  // samples, times exp(-dc^2 / 2 sigma_color^2), dc the RMS colour
+  // difference from the centre in 8-bit gamma-2 levels; sigma_color 0 = off
+  // (paper), >= 0; sigma_space > 0.
   double bilateral_sigma_color = 12;
-  double bilateral_sigma_space = 6;  // in window samples (flat-ish at 5x5)
-  // (beyond COLMAP) The least fraction of the plain (space-only) window
-  // weight the colour weights keep: where colour varies across the whole
-  // window (fine texture, shading, low resolution) rather than across an
-  // edge, sigma_color doubles, up to 8x, until the window keeps this much.
-  // An edge window keeps its own side's weight and is unchanged. 0 = a
-  // fixed sigma_color. Measured (docs/EVALUATION.md, "Bilateral window at
-  // low resolution"): the temple at 320 px 305 K -> 316 K samples, the ROS
-  // demo's cloud 12.1 K -> 16.0 K points; fountain-P11 and the rendered
-  // scenes within 0.1 points of the fixed sigma.
+  double bilateral_sigma_space = 6;
+  // Least fraction, [0, 1], of the space-only weight the colour weights
+  // keep (sigma_color doubles, up to 8x, until they do); 0 = fixed sigma.
   double bilateral_min_weight = 0.5;
-  // (beyond the paper) Step control: a full update that would turn the
-  // patch away from the camera (facing <= min_facing) has its normal part
-  // halved up to this many times, then dropped (depth only). 0 = off.
-  int normal_step_halvings = 0;
-  // (beyond the paper) Photometric model I_R = c I_V + b: a free offset b
-  // per view and channel besides the colour scale c (eliminated at its
-  // optimum: every window taken about its mean). Absorbs the local effect
-  // of gamma and tone-curve changes that a scale alone cannot (measured,
-  // docs/EVALUATION.md: under changing light completeness +0.005, median
-  // error halved; neutral with constant light). false = the paper's
-  // I_R = c I_V.
-  bool photometric_offset = true;
-  // (beyond the paper) Early failure: after this many updates, while the
-  // system settles, a pixel fails at once when fewer than min_active_views
-  // of its active views and its views not tried yet score at least
-  // drop_ncc - forecast_margin at the current patch: at settling the views
-  // below kappa leave and it would fail there (the NCCs barely move before
-  // settling; on templeSparseRing such pixels were 5 % of the MPGC runs and
-  // 3 % of the updates). -1 = off (paper).
-  int forecast_iteration = -1;
-  double forecast_margin = 0.1;      // NCC units below kappa still counted
-  bool optimize_normal = true;       // false = fronto-parallel (ablation)
-  bool optimize_color_scale = true;  // false = scales fixed to 1 (lab data)
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h), e.g. "mvs.mpgc".
@@ -158,8 +93,7 @@ struct MatchTrace {
     kFullUpdate,       // depth, normal and colour scales updated
     kDepthUpdate,      // depth only
     kConverged,
-    kFailed,
-    kForecastFailed  // failed early: too few views can pass kappa at settling
+    kFailed
   };
   struct Event {
     int iteration;
@@ -193,11 +127,12 @@ struct PatchResult {
 class PatchMatcher {
  public:
   PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
-               const LocalViewSelectionOptions& local);
+               const LocalViewSelectionOptions& local,
+               const MpgcSchedule& schedule = MpgcSchedule());
 
   // Local view selection + MPGC at pixel (s, t) (integer column and row;
   // centre (s + .5, t + .5)) from depth z and camera-frame normal `normal`.
-  // True on success (converged, facing, enough views, accept_ncc reached);
+  // True on success (converged, facing, enough views, explained);
   // fills *out. trace (may be null) records the schedule.
   bool Match(int s, int t, double depth, const Eigen::Vector3d& normal,
              PatchResult* out, MatchTrace* trace = nullptr);
@@ -233,10 +168,6 @@ class PatchMatcher {
   // Refills A by local view selection after views left; returns the number
   // that entered (sampled, with derivatives).
   int RefillActive();
-  // The forecast_iteration test: true when fewer than min_active_views of
-  // the active views and the views not tried yet (sampled in a free slot at
-  // the current patch) score >= drop_ncc - forecast_margin.
-  bool SettlingHopeless();
   bool DepthStep();
   bool FullStep(bool fit_normal, bool fit_scale);
   bool MakeResult(int iterations, PatchResult* out) const;
@@ -251,6 +182,7 @@ class PatchMatcher {
   const PatchContext& ctx_;
   MpgcOptions mpgc_;
   LocalViewSelectionOptions local_;
+  MpgcSchedule schedule_;
   int n_ = 5, half_ = 2, npix_ = 25, channels_ = 3;
   int step_ = 1, reach_ = 2;  // sample spacing; half_ * step_ (pixels)
   double max_angle_rad_ = 0;

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <vector>
 
+#include "wild_mvs/core/ablation.h"
 #include "wild_mvs/core/camera.h"
 
 namespace wild_mvs {
@@ -48,6 +49,9 @@ struct PatchContext {
   MatchImage ref_image;
   std::vector<PatchView> views;  // the neighbourhood N (<= kMaxNeighbors)
   int window = 5;                // n (odd)
+  // Parts of the method turned off (local view selection, normal, colour
+  // scales, photometric offset); all on by default.
+  AblationOptions ablation;
 
   // Adds neighbour V with camera `cam` (at the resolution of `image`).
   void AddView(int scene_view, const Camera& cam, const MatchImage& image,

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "wild_mvs/core/ablation.h"
 #include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/depth_sweep.h"
 #include "wild_mvs/core/geometric_consistency.h"
@@ -20,34 +21,34 @@
 #include "wild_mvs/core/rescaling.h"
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/core/thread_pool.h"
-#include "wild_mvs/core/view_refinement.h"
 
 namespace wild_mvs {
 
 struct MvsOptions {
   GlobalViewSelectionOptions global;
-  RescalingOptions rescaling;
   LocalViewSelectionOptions local;
   MpgcOptions mpgc;
   RegionGrowingOptions growing;
   DepthSweepOptions sweep;  // fallback seeding without sparse features
   // The filter of the finished maps against their neighbours' (run by the
-  // pipeline after every view's map exists; not by ReconstructView).
+  // command line's pipeline after every view's map exists; not by
+  // ReconstructView nor the depth node). Registered by the command line.
   GeometricConsistencyOptions consistency;
-  // The second growing pass after the filter (view_refinement.h; run by the
-  // pipeline, RefineView), then the filter again.
-  RefinementOptions refine;
-  bool use_color = true;   // false = match grey images (ablation)
   int max_image_size = 0;  // longest side of R's working image; 0 = any
+  // Parts of the method turned off for experiments; not registered by
+  // RegisterOptions below (the command line registers them as ablation.*;
+  // the ROS nodes never do).
+  AblationOptions ablation;
   void Check() const;
 };
-// Registers the fields under `prefix` (option_registry.h), e.g. "mvs".
+// Registers the fields under `prefix` (option_registry.h), e.g. "mvs",
+// except `consistency` and `ablation` (the command line's).
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      MvsOptions* options);
 
 // The paper's pipeline with the paper's values (Goesele et al. 2007,
-// section 6 and MVE's dmrecon where the paper is silent): no acceptance
-// threshold, no texture guard or step control, revisits from any better
+// section 6 and MVE's dmrecon where the paper is silent): plain windows,
+// no explain test, no photometric offset, revisits from any better
 // candidate, no consistency filter. `--preset paper`; the ablation tests
 // run on it.
 MvsOptions PaperMvsOptions();
@@ -62,9 +63,6 @@ struct ViewReport {
   int samples = 0;                     // valid depth samples in the result
   long long pixel_visits = 0;          // MPGC runs
   std::vector<std::string> fallbacks;  // "fallback: ..." notes
-  // RefineView only: samples of the map it started from and its seeds.
-  int start_samples = 0;
-  RefinementSeedStats refine_seeds;
   double seconds = 0, cpu_seconds = 0;
   // As JSON: ViewReportJson (wild_mvs/io/report_json.h).
 };
@@ -81,20 +79,6 @@ struct ViewReport {
 // grows with the collection); null = computed here.
 DepthMap ReconstructView(
     const Scene& scene, int ref, ImageCache& images, const MvsOptions& options,
-    ThreadPool* pool, ViewReport* report, const cv::Mat& mask = cv::Mat(),
-    const std::vector<std::vector<int>>* points_per_view = nullptr,
-    const std::atomic<bool>* cancel = nullptr);
-
-// The second pass of view `ref` (view_refinement.h): the same view
-// selection and rescaling as ReconstructView, then region growing into
-// `start` (ref's map after the consistency filter, at the working
-// resolution ReconstructView gives) from RefinementSeeds(start, neighbors)
-// instead of the sparse features; no depth-sweep fallback. Samples of
-// `start` are kept unless a candidate beats them by the revisit margin.
-// Deterministic for any number of threads, like ReconstructView.
-DepthMap RefineView(
-    const Scene& scene, int ref, ImageCache& images, const MvsOptions& options,
-    const DepthMap& start, const std::vector<const DepthMap*>& neighbors,
     ThreadPool* pool, ViewReport* report, const cv::Mat& mask = cv::Mat(),
     const std::vector<std::vector<int>>* points_per_view = nullptr,
     const std::atomic<bool>* cancel = nullptr);

@@ -24,41 +24,10 @@
 namespace wild_mvs {
 
 struct RegionGrowingOptions {
-  int tile_size = 32;  // (choice) side of a growth tile in pixels
-  // Seed from the neighbours' features projected into R as well (paper).
-  bool seeds_from_neighbors = true;
-  // (choice; the paper: 0) A pixel that already holds a depth is matched
-  // again only from a candidate whose expected mean NCC beats the stored
-  // one by more than this, in NCC units (confidence = (NCC + 1) / 2, so 0.1
-  // NCC = 0.05 confidence), both when the candidate is queued and when it
-  // is popped. Revisits that win by less change the depth very little but
-  // cost most of the matching time (measured on templeSparseRing: 63 % of
-  // the MPGC runs were revisits, 91 % of the successful ones improved the
-  // mean NCC by less than 0.1).
+  // A pixel that already holds a depth is matched again only from a
+  // candidate whose expected mean NCC beats the stored one by more than
+  // this, in NCC units, [0, 2] (paper: 0).
   double revisit_margin = 0.1;
-  // (beyond the paper, as PatchMatch-style systems do) When MPGC from the
-  // plane copied from the popped neighbour fails at a pixel that holds
-  // nothing yet, the planes of its reconstructed 4-neighbours and
-  // perturbations of the copied plane (depth +-1 %, normal +-15 degrees)
-  // are scored with the NCC of the unoptimised window and MPGC runs from
-  // the best this many of them (scoring above mpgc.drop_ncc). 0 = paper.
-  int hypotheses = 0;
-  // (beyond the paper, PatchMatch-style) Before the first MPGC at
-  // a pixel that holds nothing yet, the plane copied from the popped
-  // neighbour and the planes of the pixel's other reconstructed
-  // 4-neighbours are scored with the NCC of the unoptimised window (mean of
-  // the best 2 over the start_views views of the highest global score) and
-  // MPGC starts from the best. 0 = off: start from the copied plane (paper).
-  int start_views = 0;
-  // With start_views > 0: no MPGC at all when the best start scores below
-  // this (NCC units). -1 = off (always match).
-  double start_min_score = -1;
-  // (beyond the paper) A match whose mean NCC is below this is stored but
-  // does not expand: its 4-neighbours are not queued from it. Growth then
-  // cannot percolate through a region that it enters only with barely
-  // passing matches (a one-view occluder filled with the background behind
-  // it, docs/EVALUATION.md). -1 = every match expands (paper).
-  double expand_min_ncc = -1;
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h), e.g. "mvs.growing".

@@ -4,21 +4,14 @@
 
 #include <vector>
 
-#include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/scene.h"
 
 namespace wild_mvs {
 
-struct RescalingOptions {
-  bool enabled = true;
-  double min_scale = 0.6;  // t: downsample R when scale_R(V_min) < t (paper)
-  double max_scale = 1.2;  // downsample neighbours above this (paper: 1.2)
-  void Check() const;
-};
-// Registers the fields under `prefix` (option_registry.h), e.g.
-// "mvs.rescaling".
-void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
-                     RescalingOptions* options);
+// t: R is downsampled when scale_R(V_min) < t (paper: 0.6).
+constexpr double kRescaleMinScale = 0.6;
+// Neighbours whose scale exceeds this are downsampled (paper: 1.2).
+constexpr double kRescaleMaxScale = 1.2;
 
 // scale_R(V) = mean over shared features of s_R(f) / s_V(f). Without shared
 // features, the ratio of the pixel footprints at `fallback_point` (a point
@@ -34,12 +27,14 @@ struct RescalingPlan {
   std::vector<double> scales;            // scale_R(V) before rescaling
 };
 
-// Decides the working resolutions. max_image_size > 0 additionally limits
+// Decides the working resolutions: with `rescale` (false = the ablation)
+// R is downsampled when its coarsest neighbour's scale is below
+// kRescaleMinScale and neighbours above kRescaleMaxScale to R's scale.
+// max_image_size > 0 additionally limits
 // the longest side of R's working image.
 RescalingPlan PlanRescaling(const Scene& scene, int ref,
                             const std::vector<int>& neighbors,
-                            const std::vector<double>& scales,
-                            const RescalingOptions& options,
+                            const std::vector<double>& scales, bool rescale,
                             int max_image_size);
 
 }  // namespace wild_mvs

@@ -40,54 +40,21 @@ struct TrackerOptions {
   // Each new view is matched against at most this many earlier views, the
   // ones with the best frustum overlap (weighted by triangulation angle).
   int max_neighbors = 8;
-  // A pair is a candidate only when at least this fraction of sample points
-  // in the new view's frustum (image grid x depths around the scene depth)
-  // project into the other image in front of it.
-  double min_overlap = 0.1;
-  // Pairs whose optical axes differ by more than this are not matched
-  // (SIFT rarely matches beyond ~60-75 degrees of viewpoint change).
-  double max_pair_angle_deg = 75;
   // Typical depth of the scene in scene units, used for the overlap test.
   // 0 = automatic: median depth of the points already triangulated in the
   // new view's frustum, else the convergence of the optical axes, else a
   // baseline-relative depth sweep.
   double scene_depth = 0;
 
-  // --- Matching ---
-  // A match is accepted only within this distance (pixels) of the epipolar
-  // line of the known fundamental matrix, in both images.
-  double max_epipolar_distance = 1.5;
-  // Lowe's ratio test among the epipolar-compatible candidates: best
-  // distance < ratio * second best.
-  double ratio = 0.8;
-  // Absolute bound on the L2 distance of unit-normalised descriptors (0..2).
-  double max_descriptor_distance = 0.7;
-  // Keep a match only when it is the best in both directions.
-  bool mutual = true;
-
   // --- Triangulation and filtering ---
   // Observations reprojecting farther than this (pixels) are removed
-  // (worst first, at most max_outlier_removals per track, never below
-  // min_track_length); a track that still fails is rejected.
+  // (worst first, a few per track, never below min_track_length); a track
+  // that still fails is rejected.
   double max_reprojection_error = 2.0;
-  int max_outlier_removals = 3;
   // Largest pairwise angle between the lines of sight must reach this.
   double min_triangulation_angle_deg = 2.0;
-  // The size of a feature in the world (SIFT scale times the pixel footprint
-  // at the point's depth) may differ by at most this factor between the
-  // views of a track; false matches along the epipolar line often pair blobs
-  // of different sizes (on the synthetic ring scenes this removes about a
-  // quarter of the wrong 2-view tracks and ~1 % of the right ones). 0 = off.
-  double max_scale_ratio = 1.8;
-  // A track with two distinct features in one view (a wrong match joined
-  // two points) is rejected when false. When true, the point is triangulated
-  // from the views with one feature and, in each ambiguous view, the feature
-  // that reprojects best (within max_reprojection_error) is kept.
-  bool resolve_conflicts = false;
   // Tracks shorter than this (views) produce no point.
   int min_track_length = 2;
-  // Gauss-Newton iterations of the nonlinear refinement.
-  int refine_iterations = 10;
 
   // --- Memory ---
   // RemoveView compacts the union-find and the view records once removed

@@ -19,10 +19,11 @@ namespace ros1 {
 std::map<std::string, uint64_t> RoscppQueueDrops();
 
 // Adds to `drops` the roscpp queue drops of `topics` (resolved names) since
-// the last call, under "<topic>: roscpp queue full (...)".
+// the last call, under "<topic>: roscpp queue full (<hint>)"; the hint says
+// what to do, e.g. "raise ~input_queue_size".
 class RoscppDropWatch {
  public:
-  void Update(const std::map<std::string, std::string>& topic_to_param,
+  void Update(const std::map<std::string, std::string>& topic_to_hint,
               DropCounter* drops);
 
  private:

@@ -92,8 +92,8 @@ class DepthInputs {
   // The topic a frame came on (for messages) and the resolved inputs.
   std::string ImageTopic(const DepthFrame& f) const;
   std::string Topic(const std::string& name) const;
-  // The subscribed topics (resolved) and the parameters of their roscpp
-  // queue sizes.
+  // The subscribed topics (resolved) and what a full roscpp queue of each
+  // means (RoscppDropWatch's hint).
   std::map<std::string, std::string> QueueParams() const;
   const std::string& image_topic() const { return image_topic_; }
   const std::string& info_topic() const { return info_topic_; }

@@ -73,6 +73,21 @@ void ReadParams(const ParamSource& params, OptionRegistry* registry);
 std::vector<std::string> UnknownParams(const ParamSource& params,
                                        const OptionRegistry& registry);
 
+// The depth node's fixed input settings: roscpp queues of the pose, image,
+// camera_info and `keyframes` subscriptions (their overflows are counted,
+// from roscpp's bus statistics); a topic pose this close (s) to the image
+// stamp is used as is when no two poses around the stamp can be
+// interpolated; poses are interpolated only between poses at most
+// kPoseMaxGap s apart; a selector keeps the newest kKeyframeHistory
+// keyframes for ~get_keyframe.
+constexpr int kPoseQueueSize = 100;
+constexpr int kImageQueueSize = 5;
+constexpr int kCameraInfoQueueSize = 20;
+constexpr int kKeyframeQueueSize = 50;
+constexpr double kPoseSyncTolerance = 0.01;
+constexpr double kPoseMaxGap = 0.2;
+constexpr int kKeyframeHistory = 40;
+
 // Options of the depth node (its ROS-side settings plus the stream
 // reconstructor's and the core's options).
 struct DepthNodeOptions {
@@ -85,17 +100,7 @@ struct DepthNodeOptions {
   //   "odometry" (nav_msgs/Odometry). Topic poses are interpolated at the
   //   image stamp (slerp + lerp between the poses around it).
   std::string pose_source = "tf";
-  double tf_timeout = 0.2;  // s to wait for tf / a pose
-  // s: a topic pose this close to the image stamp is used as is when no
-  // two poses around the stamp can be interpolated (e.g. the last pose).
-  double pose_sync_tolerance = 0.01;
-  double pose_max_gap = 0.2;  // s: interpolate only between poses at most
-                              // this far apart (refused beyond)
-  int pose_queue_size = 100;  // roscpp queue of the pose subscription
-  // roscpp queues of the image and camera_info subscriptions (their
-  // overflows are counted too, from roscpp's bus statistics).
-  int image_queue_size = 5;
-  int camera_info_queue_size = 20;
+  double tf_timeout = 0.2;  // s to wait for tf / a pose, [0, 60]
   // The frame the topic's poses are of: "" = the camera optical frame for
   // pose / pose_with_covariance, the messages' child_frame_id for
   // transform / odometry. When it is not the camera frame (a robot body),
@@ -130,7 +135,6 @@ struct DepthNodeOptions {
   std::string sparse_source = "tracker";
   int input_queue_size = 5;  // frames waiting for the front end; the oldest
                              // is dropped (counted) beyond it
-  bool linearize = true;     // inverse sRGB on input images (core image.h)
   double diagnostics_period = 1.0;  // s
   // Stamps of frames whose images are wrongly encoded etc. are dropped with
   // a ROS_ERROR at most every error_throttle seconds per kind of problem.
@@ -152,11 +156,8 @@ struct DepthNodeOptions {
   //   keyframe `keyframe_index` announced that has not arrived after
   //   repair_delay, is fetched from the selector's `get_keyframe`.
   std::string role = "standalone";
-  int keyframe_queue_size = 50;  // roscpp queue of `keyframes` (worker)
-  int keyframe_history = 40;     // keyframes a selector keeps for
-                                 // ~get_keyframe (the newest)
-  double repair_delay = 1.0;     // s, see role "worker"
-  StreamOptions stream;          // keyframes, store, scheduling, core options
+  double repair_delay = 1.0;  // s, see role "worker"
+  StreamOptions stream;       // keyframes, store, scheduling, core options
   void Check() const;
 };
 

@@ -9,9 +9,8 @@
 // good neighbours. With select_keyframes = false every frame given is a
 // keyframe (a depth worker fed by a keyframe selector); with reconstruct =
 // false nothing is reconstructed (the selector itself). Reconstructions run on
-// an internal worker pool: AddFrame never waits for them. A keyframe may be
-// redone later when its neighbourhood became clearly better
-// (redo_min_gain). Results are handed to the result callback on a worker
+// an internal worker pool: AddFrame never waits for them. Each keyframe is
+// reconstructed once. Results are handed to the result callback on a worker
 // thread.
 //
 // Thread-safe: AddFrame / Tick / SetSparsePoints / Reset / Stats may be
@@ -40,6 +39,10 @@
 
 namespace wild_mvs {
 
+// A frame stamped more than this many seconds before the previous one
+// resets the stream (a bag loop); smaller steps back are dropped.
+constexpr double kStampResetSeconds = 1.0;
+
 struct StreamOptions {
   KeyframeSelectionOptions keyframes;
   KeyframeStoreOptions store;
@@ -63,17 +66,12 @@ struct StreamOptions {
   // keyframe, or when mvs.global.num_neighbors good neighbours are there.
   int lookahead = 2;
   double idle_flush = 1.0;
-  // Redo a reconstructed keyframe when its neighbour score grew by this
-  // factor since (0 = never), at most max_redo times.
-  double redo_min_gain = 0.0;
-  int max_redo = 1;
   // Longest image side used (input downscaled at arrival); 0 = as received.
   int max_image_size = 0;
   // A camera jump larger than this (metres) between consecutive frames less
   // than 1 s apart is a pose reset (tracking lost, relocalised): the stream
   // restarts (store and tracks cleared). 0 = never.
   double max_pose_jump = 0.0;
-  double stamp_reset_threshold = 1.0;  // s, see AddFrame
   bool use_tracker = true;  // false: sparse points come from SetSparsePoints
   MvsOptions mvs;           // the core's per-view MVS options
   TrackerOptions tracker;   // the incremental tracker (use_tracker)
@@ -164,7 +162,7 @@ class StreamReconstructor {
   // A new frame: camera (pose + intrinsics of `image`) and image (CV_32FC3
   // linear RGB of the camera's size). Call from one thread at a time (the
   // node's front end): the tracker runs here. A stamp more than
-  // stamp_reset_threshold s before the previous one resets the stream (bag
+  // kStampResetSeconds before the previous one resets the stream (bag
   // loop, restarted clock); other stamps not after the previous one are
   // kOutOfOrder. Throws Error on an invalid camera or image.
   // `stamp_ns` is the image's exact stamp (ros::Time::toNSec()); the

@@ -1,106 +1,34 @@
-// Copyright wild_mvs authors. Unit tests of the MVS core against analytic
-// ground truth: NCC invariances, MPGC on a rendered slanted plane with
-// per-view colour changes, global and local view selection on constructed
-// cameras, and region growing from a single seed.
+// Copyright wild_mvs authors. MPGC (paper 6.2) on rendered scenes with
+// exact ground truth: depth, normal and colour scales of a slanted plane
+// under changing exposure, the window step, and the bilateral window at
+// depth edges and on fine texture.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <vector>
 
+#include "mvs_test_scenes.h"
 #include "patch_context_util.h"
 #include "synthetic_scene.h"
-#include "wild_mvs/core/global_view_selection.h"
 #include "wild_mvs/core/local_view_selection.h"
 #include "wild_mvs/core/mpgc.h"
-#include "wild_mvs/core/ncc.h"
 #include "wild_mvs/core/patch.h"
-#include "wild_mvs/core/region_growing.h"
 
 namespace wild_mvs {
 namespace {
 
+using testing::LitPlaneSpec;
 using testing::Render;
 using testing::SyntheticScene;
 using testing::SyntheticSpec;
 
 constexpr double kDeg = M_PI / 180.0;
 
-// ------------------------------------------------------------------- NCC
-
-TEST(MvsNcc, InvariantToGainAndOffsetDropsForUnrelated) {
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
-  const int n = 25;
-  std::vector<float> a(3 * n), b(3 * n), c(3 * n);
-  for (auto& x : a) x = u(rng);
-  for (auto& x : c) x = u(rng);
-  // Separate gain and offset per channel.
-  const float gain[3] = {0.3f, 2.5f, 1.1f}, offset[3] = {0.2f, -0.4f, 0.05f};
-  for (int ch = 0; ch < 3; ++ch)
-    for (int i = 0; i < n; ++i)
-      b[ch * n + i] = gain[ch] * a[ch * n + i] + offset[ch];
-
-  for (int ch = 0; ch < 3; ++ch) {
-    EXPECT_NEAR(Ncc(&a[ch * n], &b[ch * n], n), 1.0, 1e-5);
-    EXPECT_LT(std::abs(Ncc(&a[ch * n], &c[ch * n], n)), 0.6);
-  }
-  // Joint NCC over channels: invariant to a common gain and a separate
-  // offset per channel (separate gains are the colour scales' job).
-  std::vector<float> common(3 * n);
-  for (int ch = 0; ch < 3; ++ch)
-    for (int i = 0; i < n; ++i)
-      common[ch * n + i] = 1.7f * a[ch * n + i] + offset[ch];
-  EXPECT_NEAR(NccChannels(a.data(), common.data(), n, 3, n), 1.0, 1e-5);
-  EXPECT_GT(NccChannels(a.data(), b.data(), n, 3, n), 0.5);
-  EXPECT_LT(std::abs(NccChannels(a.data(), c.data(), n, 3, n)), 0.4);
-  // A negative gain anti-correlates.
-  std::vector<float> neg(n);
-  for (int i = 0; i < n; ++i) neg[i] = 0.7f - 0.5f * a[i];
-  EXPECT_NEAR(Ncc(a.data(), neg.data(), n), -1.0, 1e-5);
-  // A constant window carries no information.
-  std::vector<float> flat(n, 0.3f);
-  EXPECT_EQ(Ncc(a.data(), flat.data(), n), -1.0);
-  // Noise lowers the score but keeps it well above unrelated windows.
-  std::normal_distribution<float> noise(0.f, 0.05f);
-  std::vector<float> noisy(3 * n);
-  for (int i = 0; i < 3 * n; ++i) noisy[i] = b[i] + noise(rng);
-  const double nn = NccChannels(a.data(), noisy.data(), n, 3, n);
-  EXPECT_GT(nn, 0.8);
-  EXPECT_LT(nn, 1.0);
-}
-
-// ------------------------------------------------------------------ MPGC
-
 using testing::AsMatch;
 using testing::MakeContext;
-
-// Slanted plane seen by 5 cameras with different exposure and white balance
-// (linear: gamma 1), so the colour scale of view V w.r.t. R is exactly
-// (e_R wb_R[c]) / (e_V wb_V[c]).
-SyntheticSpec LitPlaneSpec() {
-  SyntheticSpec spec = testing::SlantedPlaneSpec(30, 5);
-  spec.width = 240;
-  spec.height = 180;
-  spec.focal = 240;
-  spec.num_sparse_points = 50;
-  const double e[5] = {1.0, 0.6, 1.4, 0.8, 1.2};
-  const double wb[5][3] = {{1.0, 1.0, 1.0},
-                           {1.25, 1.0, 0.8},
-                           {0.8, 1.05, 1.2},
-                           {1.1, 0.9, 1.0},
-                           {0.9, 1.0, 1.15}};
-  for (int k = 0; k < 5; ++k) {
-    testing::ViewLighting l;
-    l.exposure = e[k];
-    l.white_balance = Eigen::Vector3d(wb[k][0], wb[k][1], wb[k][2]);
-    spec.lighting.push_back(l);
-  }
-  return spec;
-}
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) /
@@ -126,9 +54,9 @@ MpgcGridStats RunMpgcGrid(const SyntheticScene& s, int ref, int n,
   // fitted scales must equal the exposure ratios. With the offset the scale
   // is a contrast ratio (the gain splits between c and b), so only depth
   // and normals are compared.
-  mo.photometric_offset = offset;
   PatchContext ctx = MakeContext(s, ref);
   ctx.window = n;
+  ctx.ablation.photometric_offset = offset;
   PatchMatcher matcher(ctx, mo, LocalViewSelectionOptions());
   const auto& lr = s.spec.lighting[ref];
   MpgcGridStats st;
@@ -265,11 +193,10 @@ TEST(MvsMpgc, RecoversSlantedPlaneDepthNormalAndColourScales) {
     EXPECT_EQ(loff.min_ncc, LocalViewSelectionOptions().min_ncc);
   }
 
-  const PatchContext ctx = MakeContext(s, ref);
   // Without normal optimisation the normal stays fronto-parallel.
-  MpgcOptions fronto;
-  fronto.optimize_normal = false;
-  PatchMatcher fm(ctx, fronto, LocalViewSelectionOptions());
+  PatchContext fronto = MakeContext(s, ref);
+  fronto.ablation.optimize_normal = false;
+  PatchMatcher fm(fronto, MpgcOptions(), LocalViewSelectionOptions());
   PatchResult fr;
   const float gt = s.depth[ref].at<float>(90, 120);
   if (fm.Match(120, 90, gt * 1.01, Eigen::Vector3d(0, 0, -1), &fr)) {
@@ -449,276 +376,5 @@ TEST(MvsMpgc, BilateralMinWeightKeepsFineTexture) {
   EXPECT_THROW(bad.Check(), std::exception);
 }
 
-// -------------------------------------------------------- view selection
-
-Camera LookAtCamera(const Eigen::Vector3d& c, const Eigen::Vector3d& target,
-                    double focal, int w, int h) {
-  Camera cam;
-  cam.fx = cam.fy = focal;
-  cam.cx = w / 2.0;
-  cam.cy = h / 2.0;
-  cam.width = w;
-  cam.height = h;
-  const Eigen::Vector3d f = (target - c).normalized();
-  const Eigen::Vector3d r = f.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d d = f.cross(r);
-  cam.R.row(0) = r.transpose();
-  cam.R.row(1) = d.transpose();
-  cam.R.row(2) = f.transpose();
-  cam.t = -cam.R * c;
-  return cam;
-}
-
-Eigen::Vector3d OnCircle(double deg, double radius) {
-  return Eigen::Vector3d(radius * std::sin(deg * kDeg),
-                         -radius * std::cos(deg * kDeg), 0);
-}
-
-TEST(MvsGlobalViewSelection, PrefersParallaxAndMatchingResolution) {
-  Scene scene;
-  auto add = [&](const char* name, const Camera& cam) {
-    View v;
-    v.name = name;
-    v.camera = cam;
-    scene.views.push_back(v);
-  };
-  const Eigen::Vector3d o(0, 0, 0);
-  add("ref", LookAtCamera(OnCircle(0, 4), o, 400, 320, 240));          // 0
-  add("twin", LookAtCamera(OnCircle(0.2, 4), o, 400, 320, 240));       // 1
-  add("good_left", LookAtCamera(OnCircle(-15, 4), o, 400, 320, 240));  // 2
-  add("far_lowres", LookAtCamera(OnCircle(13, 4), o, 100, 80, 60));    // 3
-  add("good_right", LookAtCamera(OnCircle(16, 4), o, 400, 320, 240));  // 4
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(-0.6, 0.6);
-  for (int i = 0; i < 200; ++i) {
-    SparsePoint p;
-    p.xyz = Eigen::Vector3d(u(rng), 0.5 * u(rng), u(rng));
-    for (int v = 0; v < 5; ++v) {
-      Eigen::Vector2d px;
-      ASSERT_TRUE(scene.views[v].camera.Project(p.xyz, &px));
-      Observation ob;
-      ob.view = v;
-      ob.xy = px;
-      ob.scale = 2;
-      p.track.push_back(ob);
-    }
-    scene.points.push_back(p);
-  }
-  const auto ppv = scene.PointsPerView();
-  const GlobalViewSelection sel =
-      SelectGlobalViews(scene, 0, ppv, GlobalViewSelectionOptions());
-  ASSERT_GE(sel.neighbors.size(), 2u);
-  EXPECT_TRUE(sel.fallbacks.empty());
-  for (size_t i = 0; i < sel.neighbors.size(); ++i)
-    std::printf("neighbour %zu: %s score %.2f\n", i,
-                scene.views[sel.neighbors[i]].name.c_str(), sel.scores[i]);
-  // The good cameras rank first (in either order), the twin never enters.
-  const std::vector<int> first(sel.neighbors.begin(),
-                               sel.neighbors.begin() + 2);
-  EXPECT_TRUE(std::count(first.begin(), first.end(), 2) == 1 &&
-              std::count(first.begin(), first.end(), 4) == 1);
-  EXPECT_EQ(std::count(sel.neighbors.begin(), sel.neighbors.end(), 1), 0);
-  // If the low-resolution camera enters, it scores below the good ones.
-  for (size_t i = 2; i < sel.neighbors.size(); ++i)
-    EXPECT_LT(sel.scores[i], 0.5 * sel.scores[1]);
-  EXPECT_GT(sel.scores[0], 0);
-}
-
-TEST(MvsLocalViewSelection, SpreadsEpipolarDirections) {
-  // R at the origin looking along +y (world z up); candidates to its right
-  // on a horizontal line, and one above it.
-  const Camera r = LookAtCamera(Eigen::Vector3d(0, 0, 0),
-                                Eigen::Vector3d(0, 5, 0), 300, 320, 240);
-  const Eigen::Vector3d centers[3] = {
-      Eigen::Vector3d(0.5, 0, 0),   // right
-      Eigen::Vector3d(1.0, 0, 0),   // further right: collinear
-      Eigen::Vector3d(0, 0, 0.5)};  // above
-  Eigen::Vector2d dirs[3];
-  const double x = 170.5, y = 100.5;
-  for (int i = 0; i < 3; ++i) {
-    const Eigen::Vector3d e = r.K() * (r.R * centers[i] + r.t);
-    dirs[i] = EpipolarDirection(e, x, y);
-  }
-  EXPECT_NEAR(std::abs(dirs[0].x()), 1.0, 1e-6);
-  EXPECT_NEAR(std::abs(dirs[2].y()), 1.0, 1e-6);
-  // The collinear views have the better global scores.
-  const double scores[3] = {1.0, 0.9, 0.5};
-  uint8_t state[3] = {0, 0, 0};
-  int active[3];
-  int na = 0;
-  const double gmax = 10 * kDeg;
-  int v = PickNextView(3, scores, dirs, state, active, na, gmax);
-  EXPECT_EQ(v, 0);
-  state[v] = 1;
-  active[na++] = v;
-  v = PickNextView(3, scores, dirs, state, active, na, gmax);
-  EXPECT_EQ(v, 2);  // the vertical one before the collinear one
-  state[v] = 1;
-  active[na++] = v;
-  v = PickNextView(3, scores, dirs, state, active, na, gmax);
-  EXPECT_EQ(v, 1);
-  state[v] = 1;
-  active[na++] = v;
-  EXPECT_EQ(PickNextView(3, scores, dirs, state, active, na, gmax), -1);
-  // Rejected views are never picked again.
-  uint8_t rejected[3] = {2, 0, 0};
-  EXPECT_EQ(PickNextView(3, scores, dirs, rejected, active, 0, gmax), 1);
-
-  EXPECT_NEAR(EpipolarWeight(dirs[0], dirs[1], gmax), 0.0, 1e-6);
-  EXPECT_NEAR(EpipolarWeight(dirs[0], dirs[2], gmax), 1.0, 1e-9);
-  const Eigen::Vector2d d5(std::cos(5 * kDeg), std::sin(5 * kDeg));
-  EXPECT_NEAR(EpipolarWeight(Eigen::Vector2d(1, 0), d5, gmax), 0.5, 1e-6);
-  // Acute angle: opposite directions are the same line.
-  EXPECT_NEAR(EpipolarWeight(Eigen::Vector2d(1, 0), -d5, gmax), 0.5, 1e-6);
-}
-
-// -------------------------------------------------------- region growing
-
-struct GrowOutcome {
-  cv::Mat depth, normal, conf;
-  GrowStats stats;
-  int visible = 0, filled = 0, good = 0;
-  double median = 1, p95 = 1;
-};
-
-// Grows the rendered slanted plane of LitPlaneSpec (160 x 120, view 2) from
-// one seed 1 % off the ground truth, scored against the exact depth.
-GrowOutcome GrowPlaneFromOneSeed(const RegionGrowingOptions& options,
-                                 int threads) {
-  SyntheticSpec spec = LitPlaneSpec();
-  spec.width = 160;
-  spec.height = 120;
-  spec.focal = 160;
-  const SyntheticScene s = Render(spec);
-  const int ref = 2;
-  const PatchContext ctx = MakeContext(s, ref);
-  const cv::Mat& gt = s.depth[ref];
-  const int w = gt.cols, h = gt.rows;
-  GrowOutcome o;
-  o.depth = cv::Mat::zeros(h, w, CV_32F);
-  o.normal = cv::Mat::zeros(h, w, CV_32FC3);
-  o.conf = cv::Mat::zeros(h, w, CV_32F);
-  const int sx = w / 2, sy = h / 2;
-  std::vector<Seed> seeds{Seed{sx, sy, gt.at<float>(sy, sx) * 1.01}};
-  ThreadPool pool(threads);
-  GrowRegions(ctx, MpgcOptions(), LocalViewSelectionOptions(), options, seeds,
-              cv::Mat(), &pool, &o.depth, &o.normal, &o.conf, &o.stats);
-  EXPECT_EQ(o.stats.seeds_tried, 1);
-  EXPECT_EQ(o.stats.seeds_accepted, 1);
-  // Visible plane pixels far enough from the border for a 5x5 window.
-  std::vector<double> errs;
-  for (int y = 2; y < h - 2; ++y) {
-    for (int x = 2; x < w - 2; ++x) {
-      const float g = gt.at<float>(y, x);
-      const float d = o.depth.at<float>(y, x);
-      if (!(g > 0)) {
-        EXPECT_EQ(d, 0) << "depth on the background at " << x << "," << y;
-        continue;
-      }
-      ++o.visible;
-      if (!(d > 0)) continue;
-      ++o.filled;
-      const double e = std::abs(d - g) / g;
-      errs.push_back(e);
-      if (e < 0.005) ++o.good;
-      EXPECT_GT(o.conf.at<float>(y, x), 0);
-    }
-  }
-  EXPECT_GT(o.visible, w * h / 2);
-  std::sort(errs.begin(), errs.end());
-  if (!errs.empty()) {
-    o.median = errs[errs.size() / 2];
-    o.p95 = errs[errs.size() * 95 / 100];
-  }
-  std::printf(
-      "region growing: coverage %.3f, within 0.5%% %.3f, median rel err "
-      "%.5f, p95 %.5f, %lld visits, %d phases\n",
-      static_cast<double>(o.filled) / o.visible,
-      static_cast<double>(o.good) / o.visible, o.median, o.p95,
-      o.stats.pixel_visits, o.stats.phases);
-  return o;
-}
-
-TEST(MvsRegionGrowing, FillsTexturedPlaneFromOneSeed) {
-  const GrowOutcome o = GrowPlaneFromOneSeed(RegionGrowingOptions(), 2);
-  EXPECT_GT(static_cast<double>(o.filled) / o.visible, 0.8);
-  EXPECT_GT(static_cast<double>(o.good) / o.visible, 0.75);
-  EXPECT_LT(o.median, 0.002);
-}
-
-// mvs.growing.start_views (the best of the copied and the neighbours'
-// planes by the cheap NCC starts MPGC): the plane grows as well as from the
-// copied plane alone, the same whatever the thread count; with
-// start_min_score the pixels whose best start scores below it are not
-// matched: a bar no window reaches (NCC >= 1) grows nothing, one of 0.3
-// keeps the coverage on this well-textured plane.
-TEST(MvsRegionGrowing, StartHypothesesGrowThePlane) {
-  RegionGrowingOptions opt;
-  opt.start_views = 4;
-  const GrowOutcome a = GrowPlaneFromOneSeed(opt, 2);
-  EXPECT_GT(static_cast<double>(a.filled) / a.visible, 0.8);
-  EXPECT_GT(static_cast<double>(a.good) / a.visible, 0.75);
-  EXPECT_LT(a.median, 0.002);
-  const GrowOutcome b = GrowPlaneFromOneSeed(opt, 1);
-  EXPECT_EQ(cv::norm(a.depth, b.depth, cv::NORM_INF), 0);
-  EXPECT_EQ(cv::norm(a.conf, b.conf, cv::NORM_INF), 0);
-  EXPECT_EQ(a.stats.pixel_visits, b.stats.pixel_visits);
-
-  opt.start_min_score = 0.3;
-  const GrowOutcome c = GrowPlaneFromOneSeed(opt, 2);
-  EXPECT_GT(static_cast<double>(c.filled) / c.visible, 0.8);
-  EXPECT_LT(c.median, 0.002);
-
-  // NCC of a real window stays below 1: the seed is matched (SeedQueues),
-  // its candidate popped and skipped, nothing is stored or grown.
-  opt.start_min_score = 1;
-  const GrowOutcome d = GrowPlaneFromOneSeed(opt, 2);
-  EXPECT_EQ(d.filled, 0);
-  EXPECT_EQ(d.stats.pixel_visits, 2);
-}
-
-// mvs.growing.expand_min_ncc: a match below the bar is stored but does not
-// queue its neighbours. On the well-textured plane (matches NCC > 0.9) a bar
-// of 0.7 grows as before; a bar no match reaches keeps only the seed.
-TEST(MvsRegionGrowing, ExpandMinNccStopsGrowthFromWeakMatches) {
-  RegionGrowingOptions opt;
-  const GrowOutcome a = GrowPlaneFromOneSeed(opt, 2);
-  opt.expand_min_ncc = 0.7;
-  const GrowOutcome b = GrowPlaneFromOneSeed(opt, 2);
-  EXPECT_GT(b.filled, 0.98 * a.filled);
-  EXPECT_LT(b.median, 0.002);
-  opt.expand_min_ncc = 1;
-  const GrowOutcome c = GrowPlaneFromOneSeed(opt, 2);
-  EXPECT_EQ(c.filled, 1);
-  opt.expand_min_ncc = 1.5;
-  EXPECT_THROW(opt.Check(), std::exception);
-}
-
-}  // namespace
-}  // namespace wild_mvs
-
-namespace wild_mvs {
-namespace {
-// A track with two observations in one view (a repeated feature) lists the
-// point once for that view: global view selection counts shared points.
-TEST(Scene, PointsPerViewListsAPointOncePerView) {
-  Scene scene;
-  scene.views.resize(3);
-  SparsePoint p;
-  p.xyz = Eigen::Vector3d(0, 0, 1);
-  for (int v : {0, 1, 1, 2}) {
-    Observation o;
-    o.view = v;
-    p.track.push_back(o);
-  }
-  scene.points.push_back(p);
-  p.track.resize(2);  // views 0, 1
-  scene.points.push_back(p);
-  const auto ppv = scene.PointsPerView();
-  ASSERT_EQ(ppv.size(), 3u);
-  EXPECT_EQ(ppv[0], (std::vector<int>{0, 1}));
-  EXPECT_EQ(ppv[1], (std::vector<int>{0, 1}));
-  EXPECT_EQ(ppv[2], (std::vector<int>{0}));
-}
 }  // namespace
 }  // namespace wild_mvs
