@@ -630,7 +630,6 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   const double mean_ncc = sum / num_active_;
   if (mean_ncc < mpgc_.accept_ncc) return false;
   double pair_ncc = std::numeric_limits<double>::quiet_NaN();
-  double best_ref_ncc = std::numeric_limits<double>::quiet_NaN();
   bool explained = true;
   if (mpgc_.explain_margin >= 0 && num_active_ >= 2 &&
       mean_ncc < mpgc_.explain_below_ncc) {
@@ -640,13 +639,11 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
     for (int a = 0; a < num_active_; ++a)
       best = std::max(best, slots_[active_slot_[a]].ncc);
     pair_ncc = MeanPairwiseNcc();
-    best_ref_ncc = best;
     explained = best >= pair_ncc - mpgc_.explain_margin;
     if (!explained && !mpgc_.explain_keeps_match) return false;
   }
   if (!out) return true;
   out->pair_ncc = pair_ncc;
-  out->ref_ncc = best_ref_ncc;
   out->explained = explained;
   out->depth = h_ * ray.z();
   out->normal = mpgc_.optimize_normal ? n : Eigen::Vector3d(0, 0, -1);

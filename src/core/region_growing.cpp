@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <limits>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -145,9 +144,7 @@ class RegionGrower {
             expand_conf_,
             mpgc.explain_margin >= 0 && mpgc.explain_keeps_match
                 ? static_cast<float>(0.5 * (mpgc.explain_below_ncc + 1))
-                : 0.0f)),
-        explain_margin_(mpgc.explain_margin),
-        explain_keeps_match_(mpgc.explain_keeps_match) {
+                : 0.0f)) {
     if (!mask.empty()) mask_ = mask.isContinuous() ? mask : mask.clone();
     mmap_ = mask_.empty() ? nullptr : mask_.ptr<uint8_t>();
     dmap_ = depth->ptr<float>();
@@ -190,7 +187,6 @@ class RegionGrower {
       matchers_.Release(std::move(m));
     });
     stats_.pixel_visits += stats_.seeds_tried;
-    CalibrateExplainTest(ok, res);
     // Held samples: their empty 4-neighbours are queued (seed order, so
     // deterministic), as GrowTile does after a match.
     {
@@ -423,7 +419,7 @@ class RegionGrower {
       dmap_[p] = static_cast<float>(r.depth);
       for (int k = 0; k < 3; ++k)
         nmap_[3 * p + k] = static_cast<float>(r.normal[k]);
-      if (conf < expand_conf_ || !Explained(r)) continue;  // not expanded
+      if (conf < expand_conf_ || !r.explained) continue;  // not expanded
       const Eigen::Vector3d X0 =
           cam_.BackprojectCam(Eigen::Vector2d(x + 0.5, y + 0.5), r.depth);
       static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
@@ -461,37 +457,6 @@ class RegionGrower {
     }
   }
 
-  // The explain test per view (MpgcOptions::explain_margin, with
-  // explain_keeps_match): a match whose gap (the active views' mean NCC
-  // with each other minus the best one's with R) exceeds the margin is
-  // unexplained. Light, noise and image scale that differ between R and
-  // its views widen the gap of every match of R (R's noise is not averaged
-  // by resampling, its shading is its own), while a one-view occluder's
-  // matches stand out from R's others. So a match still expands up to the
-  // larger of the margin and the gap that kExplainSeedQuantile of R's
-  // tested seed matches stay within (tested: mean NCC with R below
-  // explain_below_ncc), once at least kMinExplainSeeds of them were tested.
-  void CalibrateExplainTest(const std::vector<int>& ok,
-                            const std::vector<PatchResult>& res) {
-    constexpr double kExplainSeedQuantile = 0.97;
-    constexpr size_t kMinExplainSeeds = 20;
-    if (!explain_keeps_match_ || explain_margin_ < 0) return;
-    std::vector<double> gaps;
-    for (size_t i = 0; i < ok.size(); ++i)
-      if (ok[i] && !std::isnan(res[i].pair_ncc))
-        gaps.push_back(res[i].pair_ncc - res[i].ref_ncc);
-    if (gaps.size() < kMinExplainSeeds) return;
-    const size_t q = static_cast<size_t>(kExplainSeedQuantile *
-                                         static_cast<double>(gaps.size() - 1));
-    std::nth_element(gaps.begin(), gaps.begin() + q, gaps.end());
-    explain_gap_ = std::max(explain_margin_, gaps[q]);
-  }
-
-  // Whether a match expands by the explain test (its own verdict or R's).
-  bool Explained(const PatchResult& r) const {
-    return r.explained || r.pair_ncc - r.ref_ncc <= explain_gap_;
-  }
-
   bool Cancelled() const {
     return cancel_ && cancel_->load(std::memory_order_relaxed);
   }
@@ -507,11 +472,6 @@ class RegionGrower {
   const double min_score_;
   const float expand_conf_;  // confidence below which a match does not expand
   const float held_expand_conf_;  // the same for held samples
-  const double explain_margin_;
-  const bool explain_keeps_match_;
-  // The gap up to which a match expands (CalibrateExplainTest); -inf =
-  // the match's own verdict.
-  double explain_gap_ = -std::numeric_limits<double>::infinity();
   cv::Mat mask_;
   const uint8_t* mmap_ = nullptr;
   float* dmap_ = nullptr;

@@ -159,15 +159,18 @@ Growth Grow(const SyntheticScene& s, const MpgcOptions& mo) {
   return g;
 }
 
-// The explain test (mpgc.explain_margin, with explain_keeps_match) under
-// light, noise and scale that change between views: every view's matches
-// have wider gaps between R's NCC and the views' mutual NCC, and with the
-// margin alone a tenth of the right matches did not expand (measured:
-// completeness 0.722 against 0.766 with the test off). With the margin per
-// view from R's seed matches growth comes within 1 % of the test being off
-// (measured: 0.763), and the test still stops growth that the margin
-// alone stops in the constant-light scene.
-TEST(ChangingLight, ExplainTestLetsRightMatchesGrow) {
+// The explain test (mpgc.explain_margin, explain_keeps_match: unexplained
+// matches keep their depth but do not expand) trades completeness for
+// gross errors, and under light, noise and scale that change between views
+// the trade is steeper: every match's gap between the views' mutual NCC and
+// R's widens, so more right matches stop growing. Measured: constant light
+// 0.760 against 0.787 with the test off (off by more than 5 %: 0.67 %
+// against 1.10 %); changing light 0.722 against 0.766 (1.09 % against
+// 1.60 %). A margin per view from the gaps of R's seed matches (the 90 %
+// quantile, untested seeds counted as explained) gave 0.739 here but raised
+// the rendered clutter scene's gross errors (0.73 % -> 0.87 %), so the
+// fixed margin stays; this test pins the trade it makes.
+TEST(ChangingLight, ExplainTestTradesCompletenessForGrossErrors) {
   for (bool changing : {false, true}) {
     const SyntheticScene& s = Scene(changing);
     MpgcOptions off;
@@ -178,10 +181,18 @@ TEST(ChangingLight, ExplainTestLetsRightMatchesGrow) {
     none.Print("explain test off");
     ASSERT_GT(none.truth, 100000);
     EXPECT_GT(none.within, 0.7 * none.truth);
-    EXPECT_GE(on.within, 0.98 * none.within);
-    // No more gross errors among the estimates than without the test.
-    EXPECT_LE(on.off5 * static_cast<double>(none.estimates),
-              none.off5 * static_cast<double>(on.estimates));
+    // Fewer gross errors among the estimates than without the test.
+    EXPECT_LT(on.off5 * static_cast<double>(none.estimates),
+              0.8 * none.off5 * static_cast<double>(on.estimates));
+    // At a cost in completeness: below 3.5 points of the ground truth with
+    // constant light, above it with changing light.
+    const double cost = (none.within - on.within) / (1.0 * none.truth);
+    if (changing) {
+      EXPECT_GT(cost, 0.035);
+    } else {
+      EXPECT_GT(cost, 0.0);
+      EXPECT_LT(cost, 0.035);
+    }
   }
 }
 

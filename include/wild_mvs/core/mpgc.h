@@ -76,13 +76,9 @@ struct MpgcOptions {
   // keeps its depth but is marked unexplained (PatchResult::explained), and
   // region growing does not expand from it, so the background cannot
   // percolate through a one-view occluder while a weak but right match
-  // still counts. With true, region growing widens the margin per view to
-  // the gaps of R's own seed matches (docs/ALGORITHM.md section 4), since
-  // light, noise and scale that differ between R and its views widen every
-  // match's gap, not only an occluder's. Measured (docs/EVALUATION.md):
-  // clutter's gross errors 1.94 -> 0.95 % at the same completeness;
-  // fountain-P11 -0.6 points of coverage (failing the match instead: -1.2 to
-  // -2.5).
+  // still counts. Measured (docs/EVALUATION.md): clutter's gross errors
+  // 1.94 -> 0.95 % at the same completeness; fountain-P11 -0.6 points of
+  // coverage (failing the match instead: -1.2 to -2.5).
   bool explain_keeps_match = true;
   // (beyond the paper) A reference window whose intensity spread is below
   // this many 8-bit sRGB levels (standard deviation, mean over channels) is
@@ -182,11 +178,8 @@ struct PatchResult {
   // Mean NCC of A's views with each other (computed when explain_margin is
   // on, else NaN).
   double pair_ncc = std::numeric_limits<double>::quiet_NaN();
-  // The best NCC of an active view with R (computed with pair_ncc, else
-  // NaN); the explain test's gap is pair_ncc - ref_ncc.
-  double ref_ncc = std::numeric_limits<double>::quiet_NaN();
-  // False when the gap exceeded explain_margin and explain_keeps_match kept
-  // the match (region growing may still expand it: its margin per view).
+  // False when the explain test failed and explain_keeps_match kept the
+  // match: growth does not expand from it.
   bool explained = true;
   int iterations = 0;
   int num_active = 0;
