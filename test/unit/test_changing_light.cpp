@@ -69,7 +69,8 @@ SyntheticSpec Spec(bool changing_light) {
     bump.texture_scale = 1.0;
     s.objects.push_back(bump);
   }
-  // Six cameras 12 degrees apart and a near-duplicate of the second one.
+  // Six cameras 12 degrees apart at 0.8 to 1.7 times the ring's distance
+  // from the scene (other image scales) and a near-duplicate of the second.
   s.camera_centers = testing::MakeRingCameras(6, 2.6, 1.5, 72);
   static const double kDist[6] = {1.0, 1.5, 0.8, 1.0, 1.7, 0.9};
   for (int k = 0; k < 6; ++k)
@@ -88,6 +89,8 @@ SyntheticSpec Spec(bool changing_light) {
     static const double kWb[kViews][3] = {
         {1.0, 1.0, 1.0},   {1.2, 1.0, 0.8},  {0.8, 1.0, 1.2}, {1.1, 0.9, 1.0},
         {0.9, 1.05, 1.15}, {1.2, 1.05, 0.8}, {1.2, 1.0, 0.8}};
+    // A sun from another direction in views 0, 1, 3 and 5; 2, 4 and 6 are
+    // overcast (the renderer's soft default shading, the same in each).
     for (int k = 0; k < kViews; ++k) {
       ViewLighting l;
       const double az = kAz[k] * M_PI / 180, el = kEl[k] * M_PI / 180;
