@@ -164,15 +164,12 @@ Growth Grow(const SyntheticScene& s, const MpgcOptions& mo) {
 
 // The explain test (mpgc.explain_margin, explain_keeps_match: unexplained
 // matches keep their depth but do not expand) trades completeness for
-// gross errors, and under light, noise and scale that change between views
-// the trade is steeper: every match's gap between the views' mutual NCC and
-// R's widens, so more right matches stop growing. Measured: constant light
-// 0.760 against 0.787 with the test off (off by more than 5 %: 0.67 %
-// against 1.10 %); changing light 0.722 against 0.766 (1.09 % against
-// 1.60 %). A margin per view from the gaps of R's seed matches (the 90 %
-// quantile, untested seeds counted as explained) gave 0.739 here but raised
-// the rendered clutter scene's gross errors (0.73 % -> 0.87 %), so the
-// fixed margin stays; this test pins the trade it makes.
+// gross errors. Under light, noise and scale that change between views the
+// gap between the views' mutual NCC and R's widens for right matches too,
+// so the trade is steeper there (docs/METHODS.md, "Tried and rejected").
+// This test bounds both sides of the trade: gross errors must fall, and the
+// completeness it costs must stay small with constant light and bounded
+// with changing light.
 TEST(ChangingLight, ExplainTestTradesCompletenessForGrossErrors) {
   for (bool changing : {false, true}) {
     const SyntheticScene& s = Scene(changing);
@@ -187,15 +184,10 @@ TEST(ChangingLight, ExplainTestTradesCompletenessForGrossErrors) {
     // Fewer gross errors among the estimates than without the test.
     EXPECT_LT(on.off5 * static_cast<double>(none.estimates),
               0.8 * none.off5 * static_cast<double>(on.estimates));
-    // At a cost in completeness: below 3.5 points of the ground truth with
-    // constant light, above it with changing light.
+    // The completeness it costs, in points of the ground truth: below 3.5
+    // with constant light, below 6 with changing light.
     const double cost = (none.within - on.within) / (1.0 * none.truth);
-    if (changing) {
-      EXPECT_GT(cost, 0.035);
-    } else {
-      EXPECT_GT(cost, 0.0);
-      EXPECT_LT(cost, 0.035);
-    }
+    EXPECT_LT(cost, changing ? 0.06 : 0.035);
   }
 }
 
