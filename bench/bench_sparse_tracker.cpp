@@ -1,7 +1,6 @@
 // Copyright wild_mvs authors. Timing and quality of the sparse tracker on a
 // dataset (cameras only; existing points are ignored).
 //   bench_sparse_tracker DATASET [max_features] [downscale] [threads]
-//                        [resolve_conflicts 0|1]
 // Prints feature extraction and matching/triangulation times, point count,
 // track-length histogram and reprojection error percentiles.
 #include <algorithm>
@@ -28,8 +27,7 @@ int main(int argc, char** argv) {
   using namespace wild_mvs;
   if (argc < 2) {
     std::cerr << "usage: " << argv[0]
-              << " DATASET [max_features] [downscale] [threads] "
-                 "[resolve_conflicts 0|1]\n";
+              << " DATASET [max_features] [downscale] [threads]\n";
     return 2;
   }
   try {
@@ -40,7 +38,6 @@ int main(int argc, char** argv) {
     if (argc > 2) opt.features.max_features = std::atoi(argv[2]);
     if (argc > 3) opt.features.downscale = std::atof(argv[3]);
     const int threads = argc > 4 ? std::atoi(argv[4]) : 2;
-    if (argc > 5) opt.resolve_conflicts = std::atoi(argv[5]) != 0;
     opt.Check();
     ThreadPool pool(threads);
     ImageCache cache(MakeSceneLoader(scene, ImageOptions()), 512);

@@ -155,7 +155,7 @@ TEST(Features, RejectsBadInput) {
   EXPECT_THROW(ExtractFeatures(cv::Mat(10, 10, CV_16UC3), FeatureOptions()),
                Error);
   FeatureOptions bad;
-  bad.contrast_threshold = 0;
+  bad.downscale = 0.5;
   EXPECT_THROW(ExtractFeatures(cv::Mat(10, 10, CV_8UC1), bad), Error);
   EXPECT_THROW(ExtractFeatures(cv::Mat(10, 10, CV_8UC1), FeatureOptions(),
                                cv::Mat(5, 5, CV_8UC1)),
