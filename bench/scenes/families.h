@@ -23,6 +23,9 @@ struct FamilyOptions {
   unsigned seed = 1;
   // Sparse points sampled with exact visibility (0.3 px noise); 0 = none.
   int points = 1500;
+  // Multiplies every object's texture contrast (albedo variation), (0, 1]:
+  // below 1 the shading of the sun carries more of each window's variation.
+  double texture_contrast = 1.0;
 };
 
 testing::SyntheticSpec ReliefScene(const FamilyOptions& options);

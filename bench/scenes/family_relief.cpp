@@ -49,6 +49,9 @@ struct Footprints {
 
 SyntheticSpec ReliefScene(const FamilyOptions& opt) {
   Require(opt.views >= 4, "relief scene: needs >= 4 views");
+  Require(opt.texture_contrast > 0 && opt.texture_contrast <= 1,
+          "relief scene: texture contrast ", opt.texture_contrast,
+          " must be in (0, 1]");
   std::mt19937 rng(opt.seed * 7919u + 17u);
   std::uniform_real_distribution<double> U01(0, 1);
   auto U = [&](double a, double b) { return a + (b - a) * U01(rng); };
@@ -262,6 +265,8 @@ SyntheticSpec ReliefScene(const FamilyOptions& opt) {
     o.only_in_view = i;
     s.objects.push_back(o);
   }
+  for (SyntheticObject& o : s.objects)
+    o.texture_contrast *= opt.texture_contrast;
   return s;
 }
 

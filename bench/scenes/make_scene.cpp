@@ -7,7 +7,7 @@
 // bench/run_families.sh and bench/run_accuracy.sh.
 //
 //   make_scene KIND OUT_DIR [--views N] [--width W] [--height H] [--seed S]
-//              [--points P]
+//              [--points P] [--contrast C]
 //
 // --views: 14 for the relief and weak families, 12 for the courtyard.
 //
@@ -15,6 +15,9 @@
 // visibility (1500; 0.3 px noise); 0 = none, so that `wild_mvs reconstruct`
 // computes tracks from the images (SIFT under the scene's light changes, as
 // a user's SfM would).
+//
+// --contrast C: the relief family's texture contrast times C, (0, 1] (1):
+// weaker texture, so the moving sun's shading weighs more in each window.
 //
 // KIND relief or weak: the families of families.h, everything drawn from
 // the seed (family_relief.cpp, family_weak.cpp).
@@ -133,10 +136,10 @@ SyntheticSpec Courtyard(const std::string& kind, int n, int w, int h,
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::cerr
-        << "usage: make_scene relief|weak|constant|light|exposure|gamma|"
-           "vignetting|sun|clutter|scale OUT_DIR "
-           "[--views N] [--width W] [--height H] [--seed S] [--points P]\n";
+    std::cerr << "usage: make_scene relief|weak|constant|light|exposure|gamma|"
+                 "vignetting|sun|clutter|scale OUT_DIR "
+                 "[--views N] [--width W] [--height H] [--seed S] [--points P] "
+                 "[--contrast C]\n";
     return 2;
   }
   try {
@@ -144,6 +147,7 @@ int main(int argc, char** argv) {
     const bool family = kind == "relief" || kind == "weak";
     int n = family ? 14 : 12, w = 640, h = 480, points = 1500;
     unsigned seed = 5;
+    double contrast = 1.0;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
       if (i + 1 >= argc) throw Error(Msg("make_scene: ", a, " needs a value"));
@@ -156,6 +160,8 @@ int main(int argc, char** argv) {
         h = std::stoi(v);
       } else if (a == "--points") {
         points = std::stoi(v);
+      } else if (a == "--contrast") {
+        contrast = std::stod(v);
       } else if (a == "--seed") {
         seed = static_cast<unsigned>(std::stoul(v));
       } else {
@@ -171,6 +177,7 @@ int main(int argc, char** argv) {
     fo.height = h;
     fo.seed = seed;
     fo.points = points;
+    fo.texture_contrast = contrast;
     const testing::SyntheticSpec spec =
         kind == "relief" ? families::ReliefScene(fo)
         : kind == "weak" ? families::WeakTextureScene(fo)

@@ -29,7 +29,7 @@ void ExpectSameValues(const cli::OptionSet& cli, const OptionRegistry& node,
     ASSERT_NE(x, nullptr) << o.key() << " is not a node parameter";
     EXPECT_EQ(x->Text(), o.Text()) << o.key();
   }
-  EXPECT_GT(n, 10) << section;
+  EXPECT_GE(n, 5) << section;  // the section was compared, not empty
 }
 
 TEST(Params, ReconstructYamlLoadsIntoTheNodes) {

@@ -48,7 +48,7 @@ TEST(FuzzRegressions, YamlConfigKeysOutliveTheIterator) {
   cli::RegisterOptions(&defaults, &options2);
   options2.LoadYamlString(ReadCorpus("yaml_config", "reconstruct_default"),
                           "reconstruct.yaml");
-  EXPECT_TRUE(defaults.image.linearize);
+  EXPECT_TRUE(defaults.mvs.ablation.linearize);
   // Errors still name the line of the bad key.
   try {
     options.LoadYamlString("run:\n  threads: 1\n  bogus: 2\n", "bad.yaml");
