@@ -21,8 +21,9 @@
 # Usage: scripts/run_sanitizers.sh [--tsan|--tsan-only]
 # Environment: JOBS (default: cores), FUZZ_BUILD_DIR (the ASan build,
 #   default build-fuzz), TSAN_BUILD_DIR, ASAN_TESTS (ctest -R regex, default
-#   all), ASAN_EXCLUDE (ctest -E regex, default the ROS tests and the
-#   repository checks, which compile nothing), TSAN_TESTS
+#   all), ASAN_EXCLUDE (ctest -E regex, default the ROS tests, the
+#   repository checks, which compile nothing, and the photos pipeline, which
+#   mostly runs colmap; its workspace writer is test_io_colmap_dense), TSAN_TESTS
 #   (ctest -R regex), TSAN_EXCLUDE (ctest -E regex). A gtest case is the
 #   ctest test <executable>.<Suite>.<Case> (<executable>_NOT_BUILT before
 #   the build; gtest_discover_tests).
@@ -32,7 +33,7 @@ source "$ROOT/scripts/common.sh"
 ASAN_BUILD_DIR="${FUZZ_BUILD_DIR:-$ROOT/build-fuzz}"
 TSAN_BUILD_DIR="${TSAN_BUILD_DIR:-$ROOT/build-tsan}"
 ASAN_TESTS="${ASAN_TESTS:-.}"
-ASAN_EXCLUDE="${ASAN_EXCLUDE:-^(_ctest_|ros_|repo_|config_files$)}"
+ASAN_EXCLUDE="${ASAN_EXCLUDE:-^(_ctest_|ros_|repo_|test_colmap_photos|config_files$)}"
 TSAN_TESTS="${TSAN_TESTS:-^test_(fusion|fusion_synthetic|mvs_end_to_end)(\.|_NOT_BUILT$)}"
 TSAN_EXCLUDE="${TSAN_EXCLUDE:-\.MvsEndToEnd\.(Ablations|VaryingLightingAndOccluder)$}"
 do_asan=1 do_tsan=0
