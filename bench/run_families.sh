@@ -27,10 +27,11 @@
 #
 # Usage: bench/run_families.sh [--seeds tune|report|all|S1,S2..]
 #          [--families "relief weak courtyard"] [--size 640] [--views N]
-#          [--points P] [--threads 2] [--out DIR] [--tag NAME]
+#          [--points P] [--noise SIGMA] [--threads 2] [--out DIR] [--tag NAME]
 #          [--skip-build | --build] [-- EXTRA reconstruct ARGS]
 # --size W: images W x 3W/4. --views N: instead of the family's own count
-# (14 relief / weak, 12 courtyard). The binaries come from
+# (14 relief / weak, 12 courtyard). --noise SIGMA: image noise of the relief
+# and weak families (make_scene --noise; default: the family's, 0.01). The binaries come from
 # BUILD_DIR (default build-bench/): built (wild_mvs, make_scene only) when
 # missing, rebuilt with --build, never with --skip-build. Rendered scenes are
 # kept in OUT/scenes and reused.
@@ -42,6 +43,7 @@ SEEDS=tune
 SIZE=640
 VIEWS=""
 POINTS=1500
+NOISE=""
 THREADS=2
 BUILD=missing
 TAG=""
@@ -54,6 +56,7 @@ while [ $# -gt 0 ]; do
     --size) SIZE="$2"; shift 2 ;;
     --views) VIEWS="$2"; shift 2 ;;
     --points) POINTS="$2"; shift 2 ;;
+    --noise) NOISE="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --tag) TAG="$2"; shift 2 ;;
@@ -115,11 +118,14 @@ for seed in $SEED_LIST; do
     read -r family kind <<<"$entry"
     views_arg=()
     [ -z "$VIEWS" ] || views_arg=(--views "$VIEWS")
-    scene="$OUT/scenes/${kind}_s${seed}_${SIZE}${VIEWS:+_v$VIEWS}_p$POINTS"
+    noise_arg=()
+    [ "$family" = courtyard ] || [ -z "$NOISE" ] || noise_arg=(--noise "$NOISE")
+    scene="$OUT/scenes/${kind}_s${seed}_${SIZE}${VIEWS:+_v$VIEWS}_p$POINTS${NOISE:+_n$NOISE}"
     if [ ! -f "$scene/gt_surface.ply" ]; then
       rm -rf "$scene"
       "$BIN/make_scene" "$kind" "$scene" --seed "$seed" --width "$SIZE" \
-        --height "$HEIGHT" --points "$POINTS" ${views_arg[@]+"${views_arg[@]}"} >&2
+        --height "$HEIGHT" --points "$POINTS" ${views_arg[@]+"${views_arg[@]}"} \
+        ${noise_arg[@]+"${noise_arg[@]}"} >&2
     fi
     run="$OUT/$TAG/${kind}_s$seed"
     rm -rf "$run"

@@ -26,6 +26,10 @@ struct FamilyOptions {
   // Multiplies every object's texture contrast (albedo variation), (0, 1]:
   // below 1 the shading of the sun carries more of each window's variation.
   double texture_contrast = 1.0;
+  // Gaussian image noise, standard deviation in image units after the
+  // camera response (SyntheticSpec::noise_sigma), [0, 0.1]. 0.01 (2.55 of
+  // 255 levels) is a typical camera's read and shot noise at low ISO.
+  double noise = 0.01;
 };
 
 testing::SyntheticSpec ReliefScene(const FamilyOptions& options);

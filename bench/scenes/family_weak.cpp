@@ -45,6 +45,7 @@ SyntheticSpec WeakTextureScene(const FamilyOptions& opt) {
   s.seed = opt.seed;
   s.num_sparse_points = opt.points;
   s.sparse_pixel_noise = 0.3;
+  s.noise_sigma = opt.noise;
   s.supersample = 2;
 
   const Eigen::Vector3d X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);

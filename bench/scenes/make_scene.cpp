@@ -8,6 +8,7 @@
 //
 //   make_scene KIND OUT_DIR [--views N] [--width W] [--height H] [--seed S]
 //              [--points P] [--contrast C]
+//              [--noise SIGMA]
 //
 // --views: 14 for the relief and weak families, 12 for the courtyard.
 //
@@ -18,6 +19,9 @@
 //
 // --contrast C: the relief family's texture contrast times C, (0, 1] (1):
 // weaker texture, so the moving sun's shading weighs more in each window.
+//
+// --noise SIGMA: Gaussian image noise of the relief and weak families, in
+// image units after the camera response, [0, 0.1] (0.01: a camera's noise).
 //
 // KIND relief or weak: the families of families.h, everything drawn from
 // the seed (family_relief.cpp, family_weak.cpp).
@@ -139,7 +143,7 @@ int main(int argc, char** argv) {
     std::cerr << "usage: make_scene relief|weak|constant|light|exposure|gamma|"
                  "vignetting|sun|clutter|scale OUT_DIR "
                  "[--views N] [--width W] [--height H] [--seed S] [--points P] "
-                 "[--contrast C]\n";
+                 "[--contrast C] [--noise SIGMA]\n";
     return 2;
   }
   try {
@@ -147,7 +151,7 @@ int main(int argc, char** argv) {
     const bool family = kind == "relief" || kind == "weak";
     int n = family ? 14 : 12, w = 640, h = 480, points = 1500;
     unsigned seed = 5;
-    double contrast = 1.0;
+    double contrast = 1.0, noise = families::FamilyOptions().noise;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
       if (i + 1 >= argc) throw Error(Msg("make_scene: ", a, " needs a value"));
@@ -162,6 +166,10 @@ int main(int argc, char** argv) {
         points = std::stoi(v);
       } else if (a == "--contrast") {
         contrast = std::stod(v);
+      } else if (a == "--noise") {
+        noise = std::stod(v);
+        Require(noise >= 0 && noise <= 0.1, "make_scene: --noise ", v,
+                " is not in [0, 0.1]");
       } else if (a == "--seed") {
         seed = static_cast<unsigned>(std::stoul(v));
       } else {
@@ -178,6 +186,7 @@ int main(int argc, char** argv) {
     fo.seed = seed;
     fo.points = points;
     fo.texture_contrast = contrast;
+    fo.noise = noise;
     const testing::SyntheticSpec spec =
         kind == "relief" ? families::ReliefScene(fo)
         : kind == "weak" ? families::WeakTextureScene(fo)
