@@ -200,8 +200,8 @@ TEST(OptionRegistry, YamlRoundTrip) {
   rb.LoadYamlString(yaml, "dump");
   EXPECT_EQ(rb.ToYaml(true), yaml);
   EXPECT_DOUBLE_EQ(b.mvs.mpgc.drop_ncc, 0.45);
-  EXPECT_DOUBLE_EQ(b.fusion.bbox_max[2], 3.5);
-  EXPECT_EQ(b.fusion.bbox_min[0], -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(b.fusion.bbox_max[2], std::optional<double>(3.5));
+  EXPECT_FALSE(b.fusion.bbox_min[0].has_value());
   EXPECT_EQ(b.run.stages, "depth,fuse");
 }
 
