@@ -30,11 +30,15 @@ void FusionOptions::Check() const {
               normal_tolerance_deg <= 180,
           "fusion.normal_tolerance_deg = ", normal_tolerance_deg,
           " must be in (0, 180]");
+  const char* const axes[] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
-    Require(!std::isnan(bbox_min[i]) && !std::isnan(bbox_max[i]) &&
-                bbox_min[i] <= bbox_max[i],
-            "fusion.bbox_min/bbox_max = [", bbox_min.transpose(), "] / [",
-            bbox_max.transpose(), "] must satisfy min <= max (no NaN)");
+    const double lo = bbox_min[i].value_or(0), hi = bbox_max[i].value_or(0);
+    Require(std::isfinite(lo) && std::isfinite(hi) &&
+                (!bbox_min[i] || !bbox_max[i] || lo <= hi),
+            "fusion.bbox_min_", axes[i], " / bbox_max_", axes[i], " = ",
+            bbox_min[i] ? Msg(lo) : "auto", " / ",
+            bbox_max[i] ? Msg(hi) : "auto",
+            " must be finite with min <= max (or auto: no bound)");
   }
   Require(std::isfinite(map_cache_mb) && map_cache_mb >= 0,
           "fusion.map_cache_mb = ", map_cache_mb, " must be >= 0");
@@ -72,15 +76,15 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   for (int k = 0; k < 3; ++k) {
     registry
         ->Add(key(std::string("bbox_min_") + axes[k]), &o->bbox_min[k],
-              Msg("bounding box minimum ", axes[k], " (world units)"))
-        .Infinite()
+              Msg("bounding box minimum ", axes[k],
+                  " (world units), auto = no bound"))
         .Note(Msg("<= bbox_max_", axes[k]));
   }
   for (int k = 0; k < 3; ++k) {
     registry
         ->Add(key(std::string("bbox_max_") + axes[k]), &o->bbox_max[k],
-              Msg("bounding box maximum ", axes[k], " (world units)"))
-        .Infinite()
+              Msg("bounding box maximum ", axes[k],
+                  " (world units), auto = no bound"))
         .Note(Msg(">= bbox_min_", axes[k]));
   }
   registry
@@ -297,11 +301,14 @@ std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::Prepare(
   auto cam_point = [&](int c, int r, float d) {
     return cam.BackprojectCam({c + 0.5, r + 0.5}, d);
   };
-  const bool has_box =
-      (options_.bbox_min.array() > -std::numeric_limits<double>::infinity())
-          .any() ||
-      (options_.bbox_max.array() < std::numeric_limits<double>::infinity())
-          .any();
+  const double inf = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d box_min, box_max;  // +-inf: no bound
+  bool has_box = false;
+  for (int k = 0; k < 3; ++k) {
+    box_min[k] = options_.bbox_min[k].value_or(-inf);
+    box_max[k] = options_.bbox_max[k].value_or(inf);
+    has_box = has_box || options_.bbox_min[k] || options_.bbox_max[k];
+  }
   auto rows = [&](int r) {
     for (int c = 0; c < w; ++c) {
       const size_t i = static_cast<size_t>(r) * w + c;
@@ -314,8 +321,8 @@ std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::Prepare(
       const Eigen::Vector3d Xc = cam_point(c, r, d);
       if (has_box) {
         const Eigen::Vector3d X = cam.CameraToWorld(Xc);
-        if ((X.array() < options_.bbox_min.array()).any() ||
-            (X.array() > options_.bbox_max.array()).any())
+        if ((X.array() < box_min.array()).any() ||
+            (X.array() > box_max.array()).any())
           continue;
       }
       Eigen::Vector3d n = Eigen::Vector3d::Zero();

@@ -120,6 +120,7 @@ std::string OptionRegistry::Option::RangeText() const {
     add(c);
   }
   if (!r.note.empty()) add(r.note);
+  if (optional_) out = out.empty() ? "auto" : out + " or auto";
   return out;
 }
 
@@ -175,7 +176,7 @@ void OptionRegistry::Option::SetBool(bool v) {
 
 void OptionRegistry::Option::SetInt(long long v) {
   if (type_ == Type::kDouble) {
-    *static_cast<double*>(field_) = static_cast<double>(v);
+    StoreDouble(static_cast<double>(v));
     return;
   }
   Require(type_ == Type::kInt, v, " is an integer, expected ", Expected(type_));
@@ -196,10 +197,27 @@ void OptionRegistry::Option::SetDouble(double v) {
           Expected(type_));
   Require(!std::isnan(v) && (allow_infinite_ || std::isfinite(v)), v,
           " is not a finite number");
-  *static_cast<double*>(field_) = v;
+  StoreDouble(v);
+}
+
+void OptionRegistry::Option::StoreDouble(double v) {
+  if (optional_) {
+    *static_cast<std::optional<double>*>(field_) = v;
+  } else {
+    *static_cast<double*>(field_) = v;
+  }
+}
+
+bool OptionRegistry::Option::IsSet() const {
+  return !optional_ ||
+         static_cast<const std::optional<double>*>(field_)->has_value();
 }
 
 void OptionRegistry::Option::SetString(const std::string& v) {
+  if (optional_) {  // "auto" / "" (other text: not a number)
+    SetText(v);
+    return;
+  }
   Require(type_ == Type::kString, "'", v, "' is a string, expected ",
           Expected(type_));
   *static_cast<std::string*>(field_) = v;
@@ -216,14 +234,17 @@ void OptionRegistry::Option::SetText(const std::string& text) {
     case Type::kDouble: {
       const std::string s = Trim(text);
       const double inf = std::numeric_limits<double>::infinity();
-      if (allow_infinite_ && (s == "inf" || s == ".inf" || s == "+inf" ||
-                              s == "+.inf" || s == ".Inf" || s == ".INF")) {
-        *static_cast<double*>(field_) = inf;
+      if (optional_ && (s.empty() || s == "auto")) {
+        static_cast<std::optional<double>*>(field_)->reset();
+      } else if (allow_infinite_ &&
+                 (s == "inf" || s == ".inf" || s == "+inf" || s == "+.inf" ||
+                  s == ".Inf" || s == ".INF")) {
+        StoreDouble(inf);
       } else if (allow_infinite_ && (s == "-inf" || s == "-.inf" ||
                                      s == "-.Inf" || s == "-.INF")) {
-        *static_cast<double*>(field_) = -inf;
+        StoreDouble(-inf);
       } else {
-        *static_cast<double*>(field_) = ParseDouble(text, "");
+        StoreDouble(ParseDouble(text, ""));
       }
       return;
     }
@@ -240,7 +261,7 @@ std::string OptionRegistry::Option::Text() const {
     case Type::kInt:
       return std::to_string(GetInt());
     case Type::kDouble:
-      return FormatDouble(GetDouble());
+      return IsSet() ? FormatDouble(GetDouble()) : "auto";
     default:
       return GetString();
   }
@@ -256,7 +277,9 @@ int OptionRegistry::Option::GetInt() const {
 }
 double OptionRegistry::Option::GetDouble() const {
   Require(type_ == Type::kDouble, key_, " is not a float");
-  return *static_cast<const double*>(field_);
+  Require(IsSet(), key_, " is unset (auto)");
+  return optional_ ? **static_cast<const std::optional<double>*>(field_)
+                   : *static_cast<const double*>(field_);
 }
 std::string OptionRegistry::Option::GetString() const {
   Require(type_ == Type::kString, key_, " is not a string");
@@ -290,6 +313,13 @@ OptionRegistry::Option& OptionRegistry::Add(const std::string& key,
                                             double* field,
                                             const std::string& help) {
   return AddOption(key, Type::kDouble, field, help);
+}
+OptionRegistry::Option& OptionRegistry::Add(const std::string& key,
+                                            std::optional<double>* field,
+                                            const std::string& help) {
+  Option& o = AddOption(key, Type::kDouble, field, help);
+  o.optional_ = true;
+  return o;
 }
 OptionRegistry::Option& OptionRegistry::Add(const std::string& key,
                                             std::string* field,

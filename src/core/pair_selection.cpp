@@ -16,7 +16,7 @@ using sparse_internal::kMinOverlap;
 
 // Typical depth of the scene seen by `cam` (0 = unknown).
 double SparseTracker::Impl::EstimateDepth(const Camera& cam) const {
-  if (opt.scene_depth > 0) return opt.scene_depth;
+  if (opt.scene_depth) return *opt.scene_depth;
   std::vector<double> depths;
   for (const auto& kv : points) {
     if (!kv.second.valid) continue;

@@ -23,8 +23,9 @@ void TrackerOptions::Check() const {
   features.Check();
   Require(max_neighbors >= 1, "tracker.max_neighbors = ", max_neighbors,
           " must be >= 1");
-  Require(scene_depth >= 0 && std::isfinite(scene_depth),
-          "tracker.scene_depth = ", scene_depth, " must be >= 0 (0 = auto)");
+  Require(!scene_depth || (*scene_depth > 0 && std::isfinite(*scene_depth)),
+          "tracker.scene_depth = ", scene_depth.value_or(0),
+          " must be > 0 (or auto: unset)");
   Require(max_reprojection_error > 0,
           "tracker.max_reprojection_error = ", max_reprojection_error,
           " must be > 0");
@@ -47,8 +48,9 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(1);
   registry
       ->Add(key("scene_depth"), &o->scene_depth,
-            "typical scene depth for the overlap test, 0 = automatic")
-      .Min(0);
+            "typical scene depth for the overlap test (scene units), auto = "
+            "estimated")
+      .Above(0);
   registry
       ->Add(key("max_reprojection_error"), &o->max_reprojection_error,
             "remove observations reprojecting farther (px)")

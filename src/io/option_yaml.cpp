@@ -76,9 +76,11 @@ void LoadOptionsYamlString(OptionRegistry* registry, const std::string& text,
                     "' is a section; its value must be a map of keys");
             registry->Set(name, "", where);  // throws "unknown option"
           }
-          Require(value.IsScalar(), where, ": value of '", name,
+          // `key:` (null) unsets an optional option.
+          const bool unset = value.IsNull() && registry->Find(name)->optional();
+          Require(value.IsScalar() || unset, where, ": value of '", name,
                   "' must be a single value, not a list or empty");
-          registry->Set(name, value.Scalar(), where);
+          registry->Set(name, unset ? std::string() : value.Scalar(), where);
         }
       };
   visit(root, "");

@@ -109,6 +109,8 @@ LiveParams::LiveParams(const ros::NodeHandle& private_nh,
   for (const std::string& key : keys) {
     Option* o = registry_->Find(key);
     Require(o != nullptr, "live parameters: unknown option key '", key, "'");
+    Require(!o->optional(), "live parameters: '", key,
+            "' may be unset, which dynamic_reconfigure cannot show");
     options_.push_back(o);
     dynamic_reconfigure::ParamDescription p;
     p.name = ParamName(key);

@@ -33,8 +33,9 @@ void SetValue(const ParamSource::Value& v, OptionRegistry::Option* o) {
   } else {
     const std::string& s = std::get<std::string>(v);
     // rosparam's YAML reads "inf" as a string; accept it where infinity is a
-    // value (an open bounding box).
-    if (o->type() == OptionRegistry::Type::kDouble && o->allow_infinite()) {
+    // value (an open bounding box), and "auto" where a number may be unset.
+    if (o->type() == OptionRegistry::Type::kDouble &&
+        (o->allow_infinite() || o->optional())) {
       o->SetText(s);
     } else {
       o->SetString(s);

@@ -10,6 +10,7 @@
 //     and counted, the keyframe store and queues within their bounds, the
 //     depth node's RSS under a ceiling, resets on every loop.
 //  4. SIGTERM: the fusion node saves its cloud to ~output_path atomically.
+// The phases run once, in this order; each test case checks one outcome.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <signal.h>
@@ -21,6 +22,8 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <thread>
+#include <tuple>
 
 #include "ros_test_scene.h"
 #include "rostest_util.h"
@@ -60,308 +63,494 @@ void WriteBag(const SyntheticScene& s, const std::vector<Frame>& frames,
       scene, [&](int i) { return images[i]; }, path, bo);
 }
 
-class Faults : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
+// The four phases of the header comment, run once and in order on the same
+// nodes (each phase starts from the state the one before left), and what
+// each observed. A phase whose precondition fails (e.g. the node is not
+// respawned) ends the run: `failure` says which, phases_done how far it
+// got; the test cases of that phase and the later ones fail with it.
+class Scenario {
+ public:
+  Scenario() : diag_(nh_) {}
+
+  void Run() {
     // 120x90 (the other ROS tests use 160x120): keeps this long test short.
     SyntheticSpec spec = RosTestSpec(kViews);
     spec.width = 120;
     spec.height = 90;
     spec.focal = 112.5;
-    scene_ = new SyntheticScene(Render(spec));
-    gt_ = new PointCloud(scene_->GroundTruthCloud(1));
+    scene_ = Render(spec);
+    gt_ = scene_.GroundTruthCloud(1);
+    dir = MakeTempDir("wild_mvs_rostest_faults");
+    s1_ = nh_.subscribe<wild_mvs::DepthView>(
+        "/depth_node/depth_view", 50,
+        [this](const wild_mvs::DepthViewConstPtr& m) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          views_.push_back(m);
+        });
+    s2_ = nh_.subscribe<sensor_msgs::PointCloud2>(
+        "/fusion_node/cloud", 2,
+        [this](const sensor_msgs::PointCloud2ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          cloud_ = m;
+        });
+    ros::AsyncSpinner spinner(2);
+    spinner.start();
+    if (!Require(WaitFor(
+                     [&] {
+                       return s1_.getNumPublishers() > 0 &&
+                              s2_.getNumPublishers() > 0;
+                     },
+                     30),
+                 "the depth and fusion nodes did not come up"))
+      return;
+    ros::WallDuration(1.0).sleep();
+    if (Restart() && (++phases_done, PoseJump()) && (++phases_done, Load()) &&
+        (++phases_done, Sigterm()))
+      ++phases_done;
   }
-  static void TearDownTestSuite() {
-    delete scene_;
-    delete gt_;
-  }
-  static SyntheticScene* scene_;
-  static PointCloud* gt_;
-};
-SyntheticScene* Faults::scene_ = nullptr;
-PointCloud* Faults::gt_ = nullptr;
 
-TEST_F(Faults, RestartPoseJumpLoadAndSigtermSave) {
-  ros::NodeHandle nh;
-  const SyntheticScene& scene = *scene_;
-  const std::string dir = MakeTempDir("wild_mvs_rostest_faults");
-  std::mutex mutex;
-  std::vector<wild_mvs::DepthViewConstPtr> views;
-  sensor_msgs::PointCloud2ConstPtr cloud;
-  ros::Subscriber s1 = nh.subscribe<wild_mvs::DepthView>(
-      "/depth_node/depth_view", 50, [&](const wild_mvs::DepthViewConstPtr& m) {
-        std::lock_guard<std::mutex> lock(mutex);
-        views.push_back(m);
-      });
-  ros::Subscriber s2 = nh.subscribe<sensor_msgs::PointCloud2>(
-      "/fusion_node/cloud", 2, [&](const sensor_msgs::PointCloud2ConstPtr& m) {
-        std::lock_guard<std::mutex> lock(mutex);
-        cloud = m;
-      });
-  DiagnosticsWatch diag(nh);
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  ASSERT_TRUE(WaitFor(
-      [&] { return s1.getNumPublishers() > 0 && s2.getNumPublishers() > 0; },
-      30));
-  ros::WallDuration(1.0).sleep();
-  auto fused = [&] { return diag.Get("fusion_node: ", "views fused"); };
-  auto cloud_precision = [&](double* recall = nullptr) {
+  // --- 1. restart ------------------------------------------------------
+  double second_start = 0;  // first stamp of the second bag
+  std::vector<wild_mvs::DepthViewConstPtr> respawned_views;
+  long depth_sessions = 0;  // the fusion node's count
+  std::string session0;     // fusion_reset's save of the first session
+  bool session0_saved = false;
+  long session0_vertices = 0;
+  long reset_resets = 0, reset_points = 0, node_points = 0;
+  std::string reset_diag;
+  double restart_p4 = 0, restart_p50 = 0;  // cloud precision @4 cm, @50 cm
+  // --- 2. tf jump ------------------------------------------------------
+  double jump_start = 0, jump_end = 0;  // stamps of the glitched frames
+  std::vector<wild_mvs::DepthViewConstPtr> jump_views;
+  double jump_p4 = 0, jump_p50 = 0;
+  // --- 3. load ---------------------------------------------------------
+  long dropped = 0, dropped_queue_full = 0, load_resets = 0;
+  long max_held = 0, max_queue = 0, max_pending = 0, max_fusion_queue = 0;
+  double depth_rss = 0;  // peak RSS of the depth node, MB
+  int depth_pid = -1, depth_pid_after = -1;
+  double load_p4 = 0, load_p50 = 0;
+  std::string load_diag;
+  // --- 4. SIGTERM ------------------------------------------------------
+  long vertices = 0, points = 0;        // saved vs the last diagnostics
+  std::vector<std::string> temp_files;  // left beside the saved cloud
+  double fusion_rss = 0;
+
+  std::string dir;
+  int phases_done = 0;
+  std::string failure;
+
+ private:
+  bool Require(bool ok, const std::string& what) {
+    if (!ok && failure.empty()) failure = what;
+    return ok;
+  }
+  long Fused() { return diag_.Get("fusion_node: ", "views fused"); }
+  std::string Dumps() {
+    return diag_.Dump("depth_node") + diag_.Dump("fusion_node: ");
+  }
+  size_t NumViews() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return views_.size();
+  }
+  std::vector<wild_mvs::DepthViewConstPtr> ViewsSince(size_t first) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return {views_.begin() + first, views_.end()};
+  }
+  // Precision of the newest fused cloud at 4 cm and 50 cm.
+  std::pair<double, double> CloudPrecision(double* recall = nullptr) {
     PointCloud c;
     {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (cloud) c = CloudFromMsg(*cloud);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (cloud_) c = CloudFromMsg(*cloud_);
     }
     CloudMetricsOptions co;
     co.taus = {0.04, 0.5};
-    const CloudMetrics m = EvaluateCloud(c, *gt_, co);
+    const CloudMetrics m = EvaluateCloud(c, gt_, co);
     if (recall) *recall = m.recall[0];
     return std::make_pair(m.precision[0], m.precision[1]);
-  };
-  const double t0 = 1000.0;
+  }
 
-  // --- 1. restart: first half, SIGKILL, respawn, second half -------------
-  std::vector<Frame> first, second;
-  for (int i = 0; i < kViews / 2; ++i) first.push_back({i});
-  for (int i = kViews / 2; i < kViews; ++i) second.push_back({i});
-  WriteBag(scene, first, t0, dir + "/first.bag");
-  WriteBag(scene, second, t0 + (kViews / 2) / kRate, dir + "/second.bag");
-  PlayBag(dir + "/first.bag", 1.0).join();
-  ASSERT_TRUE(WaitFor([&] { return fused() >= 3; }, 90))
-      << diag.Dump("depth_node") << diag.Dump("fusion_node: ");
-  const int pid1 = NodePid("/depth_node");
-  ASSERT_GT(pid1, 0);
-  ASSERT_EQ(kill(pid1, SIGKILL), 0);
-  int pid2 = -1;
-  ASSERT_TRUE(WaitFor(
-      [&] {
-        pid2 = NodePid("/depth_node");
-        return pid2 > 0 && pid2 != pid1 && s1.getNumPublishers() > 0;
-      },
-      30))
-      << "depth_node was not respawned";
-  ros::WallDuration(1.5).sleep();  // subscriptions of the new node
-  const long fused_before = fused();
-  size_t views_before = 0;
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    views_before = views.size();
-  }
-  PlayBag(dir + "/second.bag", 1.0).join();
-  ASSERT_TRUE(WaitFor([&] { return fused() >= fused_before + 3; }, 90))
-      << diag.Dump("depth_node") << diag.Dump("fusion_node: ");
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    // The respawned node's views: one new session starting at the first
-    // frame it used (the first frames of the second bag can be missed while
-    // its subscriptions connect: within 1 s), neighbours only from its own
-    // frames.
-    const double second_start = t0 + (kViews / 2) / kRate;
-    std::set<uint64_t> sessions;
-    for (size_t i = views_before; i < views.size(); ++i) {
-      const auto& v = *views[i];
-      EXPECT_GE(v.header.stamp.toSec(), second_start - 1e-6);
-      EXPECT_GE(v.session.toSec(), second_start - 1e-6);
-      EXPECT_LE(v.session.toSec(), second_start + 1.0 + 1e-6);
-      EXPECT_GE(v.header.stamp.toSec(), v.session.toSec() - 1e-6);
-      sessions.insert(v.session.toNSec());
-      for (const ros::Time& n : v.neighbor_stamps)
-        EXPECT_GE(n.toSec(), v.session.toSec() - 1e-6);
-    }
-    EXPECT_EQ(sessions.size(), 1u) << "the respawned node changed session";
-  }
-  EXPECT_GE(diag.Get("fusion_node: ", "depth sessions"), 2);
-  // on_new_session: reset (the second fusion node): the first session's
-  // cloud was saved to <output stem>_session0.ply, then a new cloud began.
-  {
+  // First half, SIGKILL, respawn, second half.
+  bool Restart() {
+    std::vector<Frame> first, second;
+    for (int i = 0; i < kViews / 2; ++i) first.push_back({i});
+    for (int i = kViews / 2; i < kViews; ++i) second.push_back({i});
+    second_start = t0_ + (kViews / 2) / kRate;
+    WriteBag(scene_, first, t0_, dir + "/first.bag");
+    WriteBag(scene_, second, second_start, dir + "/second.bag");
+    PlayBag(dir + "/first.bag", 1.0).join();
+    if (!Require(WaitFor([&] { return Fused() >= 3; }, 90),
+                 "fewer than 3 views of the first bag fused\n" + Dumps()))
+      return false;
+    const int pid1 = NodePid("/depth_node");
+    if (!Require(pid1 > 0, "no pid of the depth node") ||
+        !Require(kill(pid1, SIGKILL) == 0, "SIGKILL failed"))
+      return false;
+    int pid2 = -1;
+    if (!Require(WaitFor(
+                     [&] {
+                       pid2 = NodePid("/depth_node");
+                       return pid2 > 0 && pid2 != pid1 &&
+                              s1_.getNumPublishers() > 0;
+                     },
+                     30),
+                 "depth_node was not respawned"))
+      return false;
+    ros::WallDuration(1.5).sleep();  // subscriptions of the new node
+    const long fused_before = Fused();
+    const size_t views_before = NumViews();
+    PlayBag(dir + "/second.bag", 1.0).join();
+    if (!Require(WaitFor([&] { return Fused() >= fused_before + 3; }, 90),
+                 "fewer than 3 views of the second bag fused\n" + Dumps()))
+      return false;
+    respawned_views = ViewsSince(views_before);
+    depth_sessions = diag_.Get("fusion_node: ", "depth sessions");
+    // on_new_session: reset (the second fusion node): the first session's
+    // cloud was saved to <output stem>_session0.ply, then a new cloud began.
     std::string reset_out;
-    ASSERT_TRUE(ros::param::get("/fusion_reset/output_path", reset_out));
-    const std::string session0 =
-        reset_out.substr(0, reset_out.size() - 4) + "_session0.ply";
-    EXPECT_TRUE(WaitFor([&] { return fs::exists(session0); }, 10)) << session0;
-    EXPECT_GT(PlyVertexCount(session0), 100)
-        << session0;  // >= 3 views fused (min_support 3)
-    EXPECT_GE(diag.Get("fusion_reset: ", "resets"), 1)
-        << diag.Dump("fusion_reset: ");
-    EXPECT_LT(diag.Get("fusion_reset: ", "points"),
-              diag.Get("fusion_node: ", "points"));
+    if (!Require(ros::param::get("/fusion_reset/output_path", reset_out),
+                 "no /fusion_reset/output_path"))
+      return false;
+    session0 = reset_out.substr(0, reset_out.size() - 4) + "_session0.ply";
+    session0_saved = WaitFor([&] { return fs::exists(session0); }, 10);
+    session0_vertices = PlyVertexCount(session0);
+    reset_resets = diag_.Get("fusion_reset: ", "resets");
+    reset_points = diag_.Get("fusion_reset: ", "points");
+    node_points = diag_.Get("fusion_node: ", "points");
+    reset_diag = diag_.Dump("fusion_reset: ");
     fs::remove_all(fs::path(reset_out).parent_path());
+    ros::WallDuration(1.0).sleep();  // the cloud after the last view
+    double recall = 0;
+    std::tie(restart_p4, restart_p50) = CloudPrecision(&recall);
+    std::printf(
+        "[faults] after restart: %ld views fused, precision@4cm %.3f, "
+        "@50cm %.4f, recall@4cm %.3f\n",
+        Fused(), restart_p4, restart_p50, recall);
+    return true;
   }
-  ros::WallDuration(1.0).sleep();  // the cloud after the last view
-  double recall = 0;
-  auto [p4, p50] = cloud_precision(&recall);
-  std::printf(
-      "[faults] after restart: %ld views fused, precision@4cm %.3f, "
-      "@50cm %.4f, recall@4cm %.3f\n",
-      fused(), p4, p50, recall);
-  EXPECT_GT(p4, 0.9);
-  EXPECT_GT(p50, 0.995);
 
-  // --- 2. tf jump: frames 2 and 3 are 3 m off, then the pose is right ----
-  std::vector<Frame> jump;
-  for (int i = 0; i < 8; ++i) jump.push_back({i});
-  jump[2].offset = jump[3].offset = Eigen::Vector3d(3.0, 0.0, 0.0);
-  const double t_jump = t0 + kViews / kRate + 1.0;
-  WriteBag(scene, jump, t_jump, dir + "/jump.bag");
-  const long resets_before = diag.Get("depth_node", "stream resets");
-  const long fused_before_jump = fused();
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    views_before = views.size();
+  // Frames 2 and 3 are 3 m off, then the pose is right again.
+  bool PoseJump() {
+    std::vector<Frame> jump;
+    for (int i = 0; i < 8; ++i) jump.push_back({i});
+    jump[2].offset = jump[3].offset = Eigen::Vector3d(3.0, 0.0, 0.0);
+    t_jump_ = t0_ + kViews / kRate + 1.0;
+    jump_start = t_jump_ + 2 / kRate;
+    jump_end = t_jump_ + 4 / kRate;
+    WriteBag(scene_, jump, t_jump_, dir + "/jump.bag");
+    const long resets_before = diag_.Get("depth_node", "stream resets");
+    const long fused_before = Fused();
+    const size_t views_before = NumViews();
+    PlayBag(dir + "/jump.bag", 1.0).join();
+    if (!Require(WaitFor(
+                     [&] {
+                       return diag_.Get("depth_node", "stream resets") >=
+                                  resets_before + 2 &&
+                              Fused() >= fused_before + 2;
+                     },
+                     90),
+                 "the tf jump did not reset the stream twice or fewer than "
+                 "2 views fused\n" +
+                     Dumps()))
+      return false;
+    WaitFor(
+        [&] { return diag_.Get("depth_node", "reconstructions pending") == 0; },
+        30);
+    jump_views = ViewsSince(views_before);
+    ros::WallDuration(1.0).sleep();
+    std::tie(jump_p4, jump_p50) = CloudPrecision();
+    std::printf(
+        "[faults] after the tf jump: %ld views fused, %ld resets, "
+        "precision@4cm %.3f, @50cm %.4f\n",
+        Fused(), diag_.Get("depth_node", "stream resets"), jump_p4, jump_p50);
+    return true;
   }
-  PlayBag(dir + "/jump.bag", 1.0).join();
-  ASSERT_TRUE(WaitFor(
-      [&] {
-        return diag.Get("depth_node", "stream resets") >= resets_before + 2 &&
-               fused() >= fused_before_jump + 2;
-      },
-      90))
-      << diag.Dump("depth_node") << diag.Dump("fusion_node: ");
-  WaitFor(
-      [&] { return diag.Get("depth_node", "reconstructions pending") == 0; },
-      30);
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    const double jump_start = t_jump + 2 / kRate, jump_end = t_jump + 4 / kRate;
-    for (size_t i = views_before; i < views.size(); ++i) {
-      const auto& v = *views[i];
-      const double s = v.header.stamp.toSec();
-      // The glitched frames never make a depth map (2 keyframes in their
-      // session), and nothing after the jump back uses frames before it.
-      EXPECT_TRUE(s < jump_start - 1e-6 || s > jump_end - 1e-6)
-          << "depth map of a glitched frame at " << s;
-      if (s > jump_end - 1e-6) {
-        EXPECT_NEAR(v.session.toSec(), jump_end, 1e-6) << "view at " << s;
-        for (const ros::Time& n : v.neighbor_stamps)
-          EXPECT_GE(n.toSec(), jump_end - 1e-6) << "view at " << s;
-      } else {
-        for (const ros::Time& n : v.neighbor_stamps)
-          EXPECT_LT(n.toSec(), jump_start - 1e-6) << "view at " << s;
-      }
+
+  // 40 frames back and forth along the ring at 20x, looped.
+  bool Load() {
+    std::vector<Frame> long_bag;
+    for (int k = 0; k < 40; ++k) {
+      const int period = 2 * (kViews - 1), m = k % period;
+      long_bag.push_back({m < kViews ? m : period - m});
     }
+    const double t_load = t_jump_ + 8 / kRate + 1.0;
+    WriteBag(scene_, long_bag, t_load, dir + "/long.bag");
+    const long dropped_before = diag_.Get("depth_node", "frames dropped");
+    const long resets_before = diag_.Get("depth_node", "stream resets");
+    depth_pid = NodePid("/depth_node");
+    double max_store_mb = 0;
+    std::thread player([&] {
+      // 10 s of bag at 20x = 0.5 s per pass; `timeout` ends the loop.
+      const std::string cmd =
+          "timeout -s INT 6 rosbag play --quiet -l -r 20 '" + dir +
+          "/long.bag' >/dev/null 2>&1";
+      (void)std::system(cmd.c_str());
+    });
+    const ros::WallTime load_end =
+        ros::WallTime::now() + ros::WallDuration(7.0);
+    while (ros::WallTime::now() < load_end) {
+      max_held = std::max(max_held, diag_.Get("depth_node", "keyframes held"));
+      max_queue =
+          std::max(max_queue, diag_.Get("depth_node", "input queue length"));
+      max_pending = std::max(
+          max_pending, diag_.Get("depth_node", "reconstructions pending"));
+      max_fusion_queue = std::max(
+          max_fusion_queue, diag_.Get("fusion_node: ", "input queue length"));
+      max_store_mb = std::max(
+          max_store_mb,
+          std::atof(diag_.Values("depth_node")["keyframe store MB"].c_str()));
+      ros::WallDuration(0.1).sleep();
+    }
+    player.join();
+    dropped = diag_.Get("depth_node", "frames dropped") - dropped_before;
+    dropped_queue_full = diag_.Dropped("depth_node", "input queue full");
+    load_resets = diag_.Get("depth_node", "stream resets") - resets_before;
+    depth_rss = PeakRssMb(depth_pid);
+    load_diag = diag_.Dump("depth_node");
+    std::printf(
+        "[faults] load (20x, looped): %ld frames dropped, %ld resets, "
+        "max keyframes held %ld (%.1f MB), max queue %ld, max pending "
+        "%ld, max fusion queue %ld; depth_node peak RSS %.0f MB\n%s",
+        dropped, load_resets, max_held, max_store_mb, max_queue, max_pending,
+        max_fusion_queue, depth_rss, load_diag.c_str());
+    depth_pid_after = NodePid("/depth_node");
+    WaitFor(
+        [&] { return diag_.Get("depth_node", "reconstructions pending") == 0; },
+        60);
+    ros::WallDuration(1.5).sleep();
+    std::tie(load_p4, load_p50) = CloudPrecision();
+    return true;
   }
-  ros::WallDuration(1.0).sleep();
-  std::tie(p4, p50) = cloud_precision(&recall);
-  std::printf(
-      "[faults] after the tf jump: %ld views fused, %ld resets, "
-      "precision@4cm %.3f, @50cm %.4f\n",
-      fused(), diag.Get("depth_node", "stream resets"), p4, p50);
-  EXPECT_GT(p4, 0.9);
-  EXPECT_GT(p50, 0.995);  // no points 3 m off
 
-  // --- 3. load: 40 frames back and forth along the ring at 20x, looped ---
-  std::vector<Frame> long_bag;
-  for (int k = 0; k < 40; ++k) {
-    const int period = 2 * (kViews - 1), m = k % period;
-    long_bag.push_back({m < kViews ? m : period - m});
+  // The fusion node saves to ~output_path atomically on SIGTERM.
+  bool Sigterm() {
+    std::string out;
+    if (!Require(ros::param::get("/fusion_node/output_path", out),
+                 "no /fusion_node/output_path"))
+      return false;
+    // The fusion node may still be fusing the last depth maps: read its
+    // point count once it has stopped changing (two diagnostics reports
+    // apart).
+    points = diag_.Get("fusion_node: ", "points");
+    WaitFor(
+        [&] {
+          ros::WallDuration(2.5).sleep();
+          const long now = diag_.Get("fusion_node: ", "points");
+          const bool stable = now == points;
+          points = now;
+          return stable;
+        },
+        60);
+    fs::create_directories(fs::path(out).parent_path());
+    {
+      std::ofstream old(out);
+      old << "an earlier result\n";
+    }
+    const int fusion_pid = NodePid("/fusion_node");
+    if (!Require(fusion_pid > 0, "no pid of the fusion node")) return false;
+    fusion_rss = PeakRssMb(fusion_pid);
+    if (!Require(kill(fusion_pid, SIGTERM) == 0, "SIGTERM failed") ||
+        !Require(WaitFor([&] { return kill(fusion_pid, 0) != 0; }, 60),
+                 "fusion node did not exit on SIGTERM"))
+      return false;
+    vertices = PlyVertexCount(out);
+    for (const auto& e : fs::directory_iterator(fs::path(out).parent_path()))
+      if (e.path().filename().string().find(".tmp") != std::string::npos)
+        temp_files.push_back(e.path());
+    std::printf(
+        "[faults] SIGTERM: fusion node saved %ld points (diagnostics: "
+        "%ld); peak RSS fusion_node %.0f MB\n",
+        vertices, points, fusion_rss);
+    fs::remove_all(fs::path(out).parent_path());
+    // The second fusion node too (it saves on exit), then clean up.
+    const int reset_pid = NodePid("/fusion_reset");
+    if (reset_pid > 0 && kill(reset_pid, SIGTERM) == 0)
+      WaitFor([&] { return kill(reset_pid, 0) != 0; }, 60);
+    std::string reset_out;
+    if (ros::param::get("/fusion_reset/output_path", reset_out))
+      fs::remove_all(fs::path(reset_out).parent_path());
+    return true;
   }
-  const double t_load = t_jump + 8 / kRate + 1.0;
-  WriteBag(scene, long_bag, t_load, dir + "/long.bag");
-  const long dropped_before = diag.Get("depth_node", "frames dropped");
-  const long resets_before_load = diag.Get("depth_node", "stream resets");
-  const int depth_pid = NodePid("/depth_node");
-  long max_held = 0, max_queue = 0, max_pending = 0, max_fusion_queue = 0;
-  double max_store_mb = 0;
-  std::thread player([&] {
-    // 10 s of bag at 20x = 0.5 s per pass; `timeout` ends the loop.
-    const std::string cmd = "timeout -s INT 6 rosbag play --quiet -l -r 20 '" +
-                            dir + "/long.bag' >/dev/null 2>&1";
-    (void)std::system(cmd.c_str());
-  });
-  const ros::WallTime load_end = ros::WallTime::now() + ros::WallDuration(7.0);
-  while (ros::WallTime::now() < load_end) {
-    max_held = std::max(max_held, diag.Get("depth_node", "keyframes held"));
-    max_queue =
-        std::max(max_queue, diag.Get("depth_node", "input queue length"));
-    max_pending = std::max(max_pending,
-                           diag.Get("depth_node", "reconstructions pending"));
-    max_fusion_queue = std::max(
-        max_fusion_queue, diag.Get("fusion_node: ", "input queue length"));
-    max_store_mb = std::max(
-        max_store_mb,
-        std::atof(diag.Values("depth_node")["keyframe store MB"].c_str()));
-    ros::WallDuration(0.1).sleep();
+
+  ros::NodeHandle nh_;
+  DiagnosticsWatch diag_;
+  SyntheticScene scene_;
+  PointCloud gt_;
+  const double t0_ = 1000.0;
+  double t_jump_ = 0;
+  std::mutex mutex_;
+  std::vector<wild_mvs::DepthViewConstPtr> views_;
+  sensor_msgs::PointCloud2ConstPtr cloud_;
+  ros::Subscriber s1_, s2_;
+};
+
+class Faults : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    run_ = new Scenario();
+    run_->Run();
   }
-  player.join();
-  const long dropped =
-      diag.Get("depth_node", "frames dropped") - dropped_before;
-  const long resets =
-      diag.Get("depth_node", "stream resets") - resets_before_load;
-  const double depth_rss = PeakRssMb(depth_pid);
-  std::printf(
-      "[faults] load (20x, looped): %ld frames dropped, %ld resets, "
-      "max keyframes held %ld (%.1f MB), max queue %ld, max pending "
-      "%ld, max fusion queue %ld; depth_node peak RSS %.0f MB\n%s",
-      dropped, resets, max_held, max_store_mb, max_queue, max_pending,
-      max_fusion_queue, depth_rss, diag.Dump("depth_node").c_str());
-  EXPECT_GT(dropped, 0) << "no frame dropped at 20x";
-  EXPECT_GT(diag.Dropped("depth_node", "input queue full"), 0);
-  EXPECT_GE(resets, 1) << "bag loop (time going back) did not reset";
-  EXPECT_LE(max_held, 10);    // max_keyframes
-  EXPECT_LE(max_queue, 5);    // input_queue_size
-  EXPECT_LE(max_pending, 2);  // max_pending
-  EXPECT_LE(max_fusion_queue, 10);
-  EXPECT_GT(depth_rss, 0);
+  static void TearDownTestSuite() {
+    if (!run_->dir.empty()) fs::remove_all(run_->dir);
+    delete run_;
+    run_ = nullptr;
+  }
+  // Fails unless phases 1 .. `phase` - 1 completed and `phase` ran to its
+  // end.
+  static ::testing::AssertionResult Reached(int phase) {
+    if (run_->phases_done >= phase) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure()
+           << "phase " << phase << " did not complete: " << run_->failure;
+  }
+  static Scenario* run_;
+};
+Scenario* Faults::run_ = nullptr;
+
+// --- 1. restart ----------------------------------------------------------
+
+TEST_F(Faults, RespawnedDepthNodeStartsOneNewSession) {
+  ASSERT_TRUE(Reached(1));
+  // The respawned node's views: one new session starting at the first
+  // frame it used (the first frames of the second bag can be missed while
+  // its subscriptions connect: within 1 s), neighbours only from its own
+  // frames.
+  const double second_start = run_->second_start;
+  std::set<uint64_t> sessions;
+  for (const auto& m : run_->respawned_views) {
+    const auto& v = *m;
+    EXPECT_GE(v.header.stamp.toSec(), second_start - 1e-6);
+    EXPECT_GE(v.session.toSec(), second_start - 1e-6);
+    EXPECT_LE(v.session.toSec(), second_start + 1.0 + 1e-6);
+    EXPECT_GE(v.header.stamp.toSec(), v.session.toSec() - 1e-6);
+    sessions.insert(v.session.toNSec());
+    for (const ros::Time& n : v.neighbor_stamps)
+      EXPECT_GE(n.toSec(), v.session.toSec() - 1e-6);
+  }
+  EXPECT_EQ(sessions.size(), 1u) << "the respawned node changed session";
+}
+
+TEST_F(Faults, FusionNodeSeesTheSecondDepthSession) {
+  ASSERT_TRUE(Reached(1));
+  EXPECT_GE(run_->depth_sessions, 2);
+}
+
+TEST_F(Faults, ResetPolicySavesTheFirstSession) {
+  ASSERT_TRUE(Reached(1));
+  EXPECT_TRUE(run_->session0_saved) << run_->session0;
+  EXPECT_GT(run_->session0_vertices, 100)
+      << run_->session0;  // >= 3 views fused (min_support 3)
+}
+
+TEST_F(Faults, ResetPolicyStartsANewCloud) {
+  ASSERT_TRUE(Reached(1));
+  EXPECT_GE(run_->reset_resets, 1) << run_->reset_diag;
+  EXPECT_LT(run_->reset_points, run_->node_points);
+}
+
+TEST_F(Faults, CloudStaysRightAfterTheRestart) {
+  ASSERT_TRUE(Reached(1));
+  EXPECT_GT(run_->restart_p4, 0.9);
+  EXPECT_GT(run_->restart_p50, 0.995);
+}
+
+// --- 2. tf jump ------------------------------------------------------------
+
+TEST_F(Faults, GlitchedFramesMakeNoDepthMap) {
+  ASSERT_TRUE(Reached(2));
+  // 2 keyframes in their session: never a depth map.
+  for (const auto& v : run_->jump_views) {
+    const double s = v->header.stamp.toSec();
+    EXPECT_TRUE(s < run_->jump_start - 1e-6 || s > run_->jump_end - 1e-6)
+        << "depth map of a glitched frame at " << s;
+  }
+}
+
+TEST_F(Faults, ViewsAfterTheJumpBackUseNoEarlierFrame) {
+  ASSERT_TRUE(Reached(2));
+  const double jump_end = run_->jump_end;
+  for (const auto& v : run_->jump_views) {
+    const double s = v->header.stamp.toSec();
+    if (!(s > jump_end - 1e-6)) continue;
+    EXPECT_NEAR(v->session.toSec(), jump_end, 1e-6) << "view at " << s;
+    for (const ros::Time& n : v->neighbor_stamps)
+      EXPECT_GE(n.toSec(), jump_end - 1e-6) << "view at " << s;
+  }
+}
+
+TEST_F(Faults, ViewsBeforeTheJumpUseNoGlitchedFrame) {
+  ASSERT_TRUE(Reached(2));
+  for (const auto& v : run_->jump_views) {
+    const double s = v->header.stamp.toSec();
+    if (s > run_->jump_end - 1e-6) continue;
+    for (const ros::Time& n : v->neighbor_stamps)
+      EXPECT_LT(n.toSec(), run_->jump_start - 1e-6) << "view at " << s;
+  }
+}
+
+TEST_F(Faults, CloudStaysRightAfterTheJump) {
+  ASSERT_TRUE(Reached(2));
+  EXPECT_GT(run_->jump_p4, 0.9);
+  EXPECT_GT(run_->jump_p50, 0.995);  // no points 3 m off
+}
+
+// --- 3. load -----------------------------------------------------------------
+
+TEST_F(Faults, LoadDropsFramesAndCountsThem) {
+  ASSERT_TRUE(Reached(3));
+  EXPECT_GT(run_->dropped, 0) << "no frame dropped at 20x";
+  EXPECT_GT(run_->dropped_queue_full, 0) << run_->load_diag;
+}
+
+TEST_F(Faults, LoopedBagResetsTheStream) {
+  ASSERT_TRUE(Reached(3));
+  EXPECT_GE(run_->load_resets, 1) << "bag loop (time going back) did not reset";
+}
+
+TEST_F(Faults, StoreAndQueuesStayWithinTheirBounds) {
+  ASSERT_TRUE(Reached(3));
+  EXPECT_LE(run_->max_held, 10);    // max_keyframes
+  EXPECT_LE(run_->max_queue, 5);    // input_queue_size
+  EXPECT_LE(run_->max_pending, 2);  // max_pending
+  EXPECT_LE(run_->max_fusion_queue, 10);
+}
+
+TEST_F(Faults, DepthNodeRssStaysUnderTheCeiling) {
+  ASSERT_TRUE(Reached(3));
+  EXPECT_GT(run_->depth_rss, 0);
   // RSS ceiling about 2x the measured peak (94-95 MB; docs/ROS.md).
-  EXPECT_LT(depth_rss, 200.0);
-  // The nodes are still up and the cloud is still right.
-  EXPECT_EQ(NodePid("/depth_node"), depth_pid);
-  WaitFor(
-      [&] { return diag.Get("depth_node", "reconstructions pending") == 0; },
-      60);
-  ros::WallDuration(1.5).sleep();
-  std::tie(p4, p50) = cloud_precision(&recall);
-  EXPECT_GT(p4, 0.9);
-  EXPECT_GT(p50, 0.995);
+  EXPECT_LT(run_->depth_rss, 200.0);
+}
 
-  // --- 4. SIGTERM: the fusion node saves to ~output_path atomically ------
-  std::string out;
-  ASSERT_TRUE(ros::param::get("/fusion_node/output_path", out));
-  // The fusion node may still be fusing the last depth maps: read its point
-  // count once it has stopped changing (two diagnostics reports apart).
-  long points = diag.Get("fusion_node: ", "points");
-  WaitFor(
-      [&] {
-        ros::WallDuration(2.5).sleep();
-        const long now = diag.Get("fusion_node: ", "points");
-        const bool stable = now == points;
-        points = now;
-        return stable;
-      },
-      60);
-  fs::create_directories(fs::path(out).parent_path());
-  {
-    std::ofstream old(out);
-    old << "an earlier result\n";
-  }
-  const int fusion_pid = NodePid("/fusion_node");
-  ASSERT_GT(fusion_pid, 0);
-  const double fusion_rss = PeakRssMb(fusion_pid);
-  ASSERT_EQ(kill(fusion_pid, SIGTERM), 0);
-  ASSERT_TRUE(WaitFor([&] { return kill(fusion_pid, 0) != 0; }, 60))
-      << "fusion node did not exit on SIGTERM";
-  const long vertices = PlyVertexCount(out);
-  EXPECT_GT(vertices, 1000) << "no valid PLY saved at " << out;
-  EXPECT_NEAR(vertices, points, points * 0.05 + 10);
-  for (const auto& e : fs::directory_iterator(fs::path(out).parent_path()))
-    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos)
-        << "temporary file left: " << e.path();
-  std::printf(
-      "[faults] SIGTERM: fusion node saved %ld points (diagnostics: "
-      "%ld); peak RSS fusion_node %.0f MB\n",
-      vertices, points, fusion_rss);
+TEST_F(Faults, DepthNodeSurvivesTheLoad) {
+  ASSERT_TRUE(Reached(3));
+  EXPECT_EQ(run_->depth_pid_after, run_->depth_pid);
+}
+
+TEST_F(Faults, CloudStaysRightAfterTheLoad) {
+  ASSERT_TRUE(Reached(3));
+  EXPECT_GT(run_->load_p4, 0.9);
+  EXPECT_GT(run_->load_p50, 0.995);
+}
+
+// --- 4. SIGTERM --------------------------------------------------------------
+
+TEST_F(Faults, SigtermSavesTheWholeCloud) {
+  ASSERT_TRUE(Reached(4));
+  EXPECT_GT(run_->vertices, 1000) << "no valid PLY saved";
+  EXPECT_NEAR(run_->vertices, run_->points, run_->points * 0.05 + 10);
+}
+
+TEST_F(Faults, SigtermSaveLeavesNoTemporaryFile) {
+  ASSERT_TRUE(Reached(4));
+  for (const std::string& f : run_->temp_files)
+    ADD_FAILURE() << "temporary file left: " << f;
+}
+
+TEST_F(Faults, FusionNodeRssStaysUnderTheCeiling) {
+  ASSERT_TRUE(Reached(4));
   // RSS ceiling about 2x the measured peak (91-101 MB; docs/ROS.md).
-  EXPECT_GT(fusion_rss, 0);
-  EXPECT_LT(fusion_rss, 200.0);
-  fs::remove_all(fs::path(out).parent_path());
-  // The second fusion node too (it saves on exit), then clean up.
-  const int reset_pid = NodePid("/fusion_reset");
-  if (reset_pid > 0 && kill(reset_pid, SIGTERM) == 0)
-    WaitFor([&] { return kill(reset_pid, 0) != 0; }, 60);
-  std::string reset_out;
-  if (ros::param::get("/fusion_reset/output_path", reset_out))
-    fs::remove_all(fs::path(reset_out).parent_path());
-  fs::remove_all(dir);
+  EXPECT_GT(run_->fusion_rss, 0);
+  EXPECT_LT(run_->fusion_rss, 200.0);
 }
 
 }  // namespace

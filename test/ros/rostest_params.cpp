@@ -72,8 +72,8 @@ TEST(Params, ReconstructYamlLoadsIntoTheNodes) {
   RegisterOptions(&fusion, "", &f);
   ExpectSameValues(cli, fusion, "fusion");  // bbox .inf included
   EXPECT_EQ(f.fusion.min_support, 2);
-  EXPECT_DOUBLE_EQ(f.fusion.bbox_max[2], 10.0);
-  EXPECT_TRUE(std::isinf(f.fusion.bbox_min[0]));
+  EXPECT_EQ(f.fusion.bbox_max[2], std::optional<double>(10.0));
+  EXPECT_FALSE(f.fusion.bbox_min[0].has_value());
 }
 
 // The depth node started with depth_node.yaml + the tuned file comes up

@@ -119,7 +119,7 @@ TEST(Params, ConfigFilesLoadAsTheDefaults) {
   EXPECT_DOUBLE_EQ(f.map_store_mb, 256.0);
   EXPECT_LT(f.fusion.map_cache_mb, FusionOptions().map_cache_mb);
   EXPECT_LT(f.fusion.pending_mb, FusionOptions().pending_mb);
-  EXPECT_EQ(f.fusion.bbox_min[0], -std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(f.fusion.bbox_min[0].has_value());
   // Every parameter is in the file.
   DepthNodeOptions o;
   OptionRegistry r;

@@ -115,7 +115,7 @@ TEST(FusionOptions, CheckRejectsBadValues) {
   bad([](FusionOptions& b) { b.depth_tolerance = -1; }, "depth_tolerance");
   bad([](FusionOptions& b) { b.normal_tolerance_deg = NAN; },
       "normal_tolerance_deg");
-  bad([](FusionOptions& b) { b.bbox_min.x() = 5, b.bbox_max.x() = 1; }, "bbox");
+  bad([](FusionOptions& b) { b.bbox_min[0] = 5, b.bbox_max[0] = 1; }, "bbox");
   bad([](FusionOptions& b) { b.map_cache_mb = -1; }, "map_cache_mb");
   bad([](FusionOptions& b) { b.memory_mb = NAN; }, "memory_mb");
   bad([](FusionOptions& b) { b.reprojection_tolerance_px = 0; },
@@ -381,8 +381,8 @@ TEST(Fusion, MasksBoundingBoxAndConfidence) {
   FusionOptions o;
   // Bounding box: only the upper half of the sphere.
   FusionOptions box = o;
-  box.bbox_min = Eigen::Vector3d(-1, -1, 0.1);
-  box.bbox_max = Eigen::Vector3d(1, 1, 1);
+  box.bbox_min = {-1.0, -1.0, 0.1};
+  box.bbox_max = {1.0, 1.0, 1.0};
   const PointCloud pb = FuseDepthMaps(Range(prov.n), box, prov.Get());
   ASSERT_GT(pb.size(), 1000u);
   for (const auto& p : pb.xyz) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <optional>
 #include <set>
 
 #include "option_ranges.h"
@@ -85,6 +86,86 @@ TEST(OptionRegistry, ParsesByTypeOnly) {
   }
 }
 
+TEST(OptionRegistry, OptionalDoubleMayBeUnset) {
+  std::optional<double> depth;
+  OptionRegistry r;
+  OptionRegistry::Option& o =
+      r.Add("a.depth", &depth, "scene depth; auto = estimated").Above(0);
+  EXPECT_TRUE(o.optional());
+  EXPECT_EQ(o.type(), OptionRegistry::Type::kDouble);
+  EXPECT_EQ(o.RangeText(), "> 0 or auto");
+  EXPECT_FALSE(o.IsSet());
+  EXPECT_EQ(o.Text(), "auto");
+  EXPECT_THROW(o.GetDouble(), Error);
+  r.Set("a.depth", "2.5", "here");
+  ASSERT_TRUE(depth.has_value());
+  EXPECT_EQ(*depth, 2.5);
+  EXPECT_TRUE(o.IsSet());
+  EXPECT_EQ(o.GetDouble(), 2.5);
+  EXPECT_EQ(o.Text(), "2.5");
+  r.Set("a.depth", " auto ", "here");
+  EXPECT_FALSE(depth.has_value());
+  o.SetInt(3);  // a ROS integer parameter
+  EXPECT_EQ(depth, std::optional<double>(3.0));
+  o.SetText("");  // an empty value unsets
+  EXPECT_FALSE(depth.has_value());
+  o.SetDouble(0.25);
+  EXPECT_EQ(depth, std::optional<double>(0.25));
+  o.SetString("auto");  // a ROS string parameter
+  EXPECT_FALSE(depth.has_value());
+  // Anything else must be a finite number.
+  EXPECT_THROW(r.Set("a.depth", "automatic", "here"), Error);
+  EXPECT_THROW(r.Set("a.depth", "inf", "here"), Error);
+  EXPECT_THROW(o.SetString("far"), Error);
+  EXPECT_THROW(o.SetDouble(std::numeric_limits<double>::quiet_NaN()), Error);
+  EXPECT_FALSE(depth.has_value());
+}
+
+TEST(OptionRegistry, OptionalDoubleInYaml) {
+  std::optional<double> a = 1.5, b = 2.0, c;
+  cli::OptionSet r;
+  r.Add("s.a", &a, "a");
+  r.Add("s.b", &b, "b");
+  r.Add("s.c", &c, "c");
+  // `auto` and an empty value unset; a key not given keeps its value.
+  r.LoadYamlString("s:\n  a: auto\n  b:\n", "cfg.yaml");
+  EXPECT_FALSE(a.has_value());
+  EXPECT_FALSE(b.has_value());
+  EXPECT_FALSE(c.has_value());
+  r.LoadYamlString("s:\n  c: 4\n", "cfg.yaml");
+  EXPECT_EQ(c, std::optional<double>(4.0));
+  EXPECT_FALSE(a.has_value());
+  // Written as `auto`, read back the same.
+  const std::string yaml = r.ToYaml(false);
+  EXPECT_EQ(yaml, "s:\n  a: auto\n  b: auto\n  c: 4\n");
+  std::optional<double> a2 = 7, b2 = 7, c2;
+  cli::OptionSet r2;
+  r2.Add("s.a", &a2, "a");
+  r2.Add("s.b", &b2, "b");
+  r2.Add("s.c", &c2, "c");
+  r2.LoadYamlString(yaml, "dump");
+  EXPECT_FALSE(a2.has_value());
+  EXPECT_FALSE(b2.has_value());
+  EXPECT_EQ(c2, std::optional<double>(4.0));
+  // An empty value is an error where the option may not be unset.
+  double d = 1;
+  r2.Add("s.d", &d, "d");
+  EXPECT_THROW(r2.LoadYamlString("s:\n  d:\n", "cfg.yaml"), Error);
+}
+
+TEST(OptionRegistry, TrackerSceneDepthIsAutoByDefault) {
+  cli::ReconstructConfig c;
+  OptionRegistry r;
+  cli::RegisterOptions(&c, &r);
+  EXPECT_FALSE(c.tracker.scene_depth.has_value());
+  EXPECT_EQ(r.Find("tracker.scene_depth")->Text(), "auto");
+  r.Set("tracker.scene_depth", "3", "test");
+  EXPECT_EQ(c.tracker.scene_depth, std::optional<double>(3.0));
+  EXPECT_NO_THROW(c.tracker.Check());
+  c.tracker.scene_depth = 0.0;  // set, but not a depth
+  EXPECT_THROW(c.tracker.Check(), Error);
+}
+
 TEST(OptionRegistry, RangeText) {
   int w = 5, z = 0;
   double x = 0;
@@ -119,8 +200,8 @@ TEST(OptionRegistry, YamlRoundTrip) {
   rb.LoadYamlString(yaml, "dump");
   EXPECT_EQ(rb.ToYaml(true), yaml);
   EXPECT_DOUBLE_EQ(b.mvs.mpgc.drop_ncc, 0.45);
-  EXPECT_DOUBLE_EQ(b.fusion.bbox_max[2], 3.5);
-  EXPECT_EQ(b.fusion.bbox_min[0], -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(b.fusion.bbox_max[2], std::optional<double>(3.5));
+  EXPECT_FALSE(b.fusion.bbox_min[0].has_value());
   EXPECT_EQ(b.run.stages, "depth,fuse");
 }
 

@@ -46,6 +46,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -54,6 +55,7 @@
 #include <map>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -87,11 +89,10 @@ struct FusionOptions {
   // (COLMAP max_normal_error = 10; MVS normals are noisier, hence 20). Also
   // used when merging samples into one point.
   double normal_tolerance_deg = 20.0;
-  // Bounding box in world units; samples outside are ignored. Default: none.
-  Eigen::Vector3d bbox_min =
-      Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
-  Eigen::Vector3d bbox_max =
-      Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  // Bounding box in world units (x, y, z); samples outside are ignored.
+  // Finite, min <= max where both are set; unset = no bound on that side
+  // (the default: no box).
+  std::array<std::optional<double>, 3> bbox_min, bbox_max;
   // Budget of the depth-map LRU in megabytes (prepared maps: 20 bytes per
   // pixel). The maps in use by one AddView are held regardless.
   double map_cache_mb = 512;

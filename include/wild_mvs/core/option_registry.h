@@ -16,12 +16,19 @@
 // documents the range (Option::RangeText()); a test checks that the stated
 // bounds agree with Check().
 //
+// A std::optional<double> field is an option that may be unset (e.g. "auto":
+// the code chooses): it is written `auto` when unset, and the text `auto` or
+// an empty value (command line `--key auto`, YAML `key: auto` or `key:`, the
+// ROS string parameter "auto") unsets it; a key that is not given keeps the
+// default. Its range text ends in "or auto".
+//
 // The registry holds pointers into the registered structs: they must outlive
 // it and must not move.
 #pragma once
 
 #include <deque>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,9 +58,14 @@ class OptionRegistry {
     const std::string& help() const { return help_; }
     const Range& range() const { return range_; }
     bool allow_infinite() const { return allow_infinite_; }
+    // A std::optional<double> field (type kDouble) that may be unset.
+    bool optional() const { return optional_; }
+    // False only for an unset optional option.
+    bool IsSet() const;
     // "bool", "int", "float" or "string".
     const char* TypeName() const;
-    // "odd, [3, 9]", ">= 0", "tf|topic", "> 0, > settle_iterations", or "".
+    // "odd, [3, 9]", ">= 0", "tf|topic", "> 0, > settle_iterations",
+    // "> 0 or auto" (optional), or "".
     std::string RangeText() const;
 
     // Documentation of the range (builder style, in RegisterOptions):
@@ -77,14 +89,16 @@ class OptionRegistry {
     void SetDouble(double v);
     void SetString(const std::string& v);
     // Parses text by type (command line, YAML scalars) and stores it; throws
-    // Error (without the key) when it is not a value of the type.
+    // Error (without the key) when it is not a value of the type. For an
+    // optional option "auto" and "" unset it.
     void SetText(const std::string& text);
     // The current value as text (parsed back by SetText). Infinity is
-    // written ".inf" / "-.inf" (YAML's spelling).
+    // written ".inf" / "-.inf" (YAML's spelling), an unset optional "auto".
     std::string Text() const;
 
     bool GetBool() const;
     int GetInt() const;
+    // Throws Error for an unset optional option (see IsSet).
     double GetDouble() const;
     std::string GetString() const;
 
@@ -95,14 +109,19 @@ class OptionRegistry {
     std::string help_;
     Range range_;
     bool allow_infinite_ = false;
+    bool optional_ = false;  // field_ is a std::optional<double>
     void* field_ = nullptr;
+    void StoreDouble(double v);
   };
 
-  // Registers a field. T is bool, int, double or std::string. Throws Error
-  // when the key is registered twice.
+  // Registers a field. T is bool, int, double, std::optional<double> (type
+  // kDouble, may be unset: see above) or std::string. Throws Error when the
+  // key is registered twice.
   Option& Add(const std::string& key, bool* field, const std::string& help);
   Option& Add(const std::string& key, int* field, const std::string& help);
   Option& Add(const std::string& key, double* field, const std::string& help);
+  Option& Add(const std::string& key, std::optional<double>* field,
+              const std::string& help);
   Option& Add(const std::string& key, std::string* field,
               const std::string& help);
 

@@ -21,6 +21,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -40,11 +41,11 @@ struct TrackerOptions {
   // Each new view is matched against at most this many earlier views, the
   // ones with the best frustum overlap (weighted by triangulation angle).
   int max_neighbors = 8;
-  // Typical depth of the scene in scene units, used for the overlap test.
-  // 0 = automatic: median depth of the points already triangulated in the
-  // new view's frustum, else the convergence of the optical axes, else a
-  // baseline-relative depth sweep.
-  double scene_depth = 0;
+  // Typical depth of the scene in scene units, used for the overlap test,
+  // > 0. Unset = automatic: median depth of the points already triangulated
+  // in the new view's frustum, else the convergence of the optical axes,
+  // else a baseline-relative depth sweep.
+  std::optional<double> scene_depth;
 
   // --- Triangulation and filtering ---
   // Observations reprojecting farther than this (pixels) are removed
