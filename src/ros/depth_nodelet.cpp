@@ -80,7 +80,7 @@ struct DepthNode::Impl {
           "message per %.0f s)",
           pnh.getNamespace().c_str(), static_cast<unsigned long>(total),
           options.stream.store.max_keyframes, options.stream.store.max_mb,
-          options.error_throttle);
+          kErrorThrottle);
   }
 
   // Counts and (throttled) reports one dropped input.
@@ -94,7 +94,7 @@ struct DepthNode::Impl {
           "per %.0f s per problem)",
           pnh.getNamespace().c_str(), reason.c_str(),
           detail.empty() ? "" : ": ", detail.c_str(),
-          static_cast<unsigned long>(n), options.error_throttle);
+          static_cast<unsigned long>(n), kErrorThrottle);
     }
   }
 
@@ -272,10 +272,10 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.options.world_frame = m.inputs->NoSlash(m.options.world_frame);
   if (!m.options.camera_frame.empty())
     m.options.camera_frame = m.inputs->NoSlash(m.options.camera_frame);
-  m.drops.set_throttle(m.options.error_throttle);
-  m.evictions.set_throttle(m.options.error_throttle);
-  m.drops.set_window(m.options.drop_window);
-  m.evictions.set_window(m.options.drop_window);
+  m.drops.set_throttle(kErrorThrottle);
+  m.evictions.set_throttle(kErrorThrottle);
+  m.drops.set_window(kDropWindow);
+  m.evictions.set_window(kDropWindow);
   const DepthNodeOptions& o = m.options;
 
   // Created before any callback or worker can tick them.
@@ -304,7 +304,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       [&m](DepthFrame f) { m.FrontEnd(std::move(f)); });
   if (o.role == "worker") {
     m.receiver = std::make_unique<KeyframeReceiver>(
-        m.nh, o.repair_delay,
+        m.nh, kRepairDelay,
         [&m](const wild_mvs::SelectedKeyframeConstPtr& k) {
           m.TakeKeyframe(k);
         },

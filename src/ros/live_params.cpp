@@ -76,6 +76,7 @@ double Value(const Option& o) {
 double Bound(const Option& o, bool upper) {
   const OptionRegistry::Range& r = o.range();
   const bool has = upper ? r.has_max : r.has_min;
+  if (!upper && has && r.or_zero && r.min > 0) return 0;  // "0 or >= min"
   if (has) return upper ? r.max : r.min;
   if (o.type() == Type::kInt)
     return upper ? std::numeric_limits<int>::max()

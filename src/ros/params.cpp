@@ -129,16 +129,12 @@ void DepthNodeOptions::Check() const {
           "input_queue_size = ", input_queue_size, " must be in [1, 1000]");
   Require(std::isfinite(diagnostics_period) && diagnostics_period > 0,
           "diagnostics_period = ", diagnostics_period, " must be > 0");
-  Require(std::isfinite(error_throttle) && error_throttle >= 0,
-          "error_throttle = ", error_throttle, " must be >= 0");
-  Require(
-      std::isfinite(drop_window) && drop_window >= 0.1 && drop_window <= 86400,
-      "drop_window = ", drop_window, " must be in [0.1, 86400] s");
   Require(role == "standalone" || role == "selector" || role == "worker",
           "role = '", role, "' must be 'standalone', 'selector' or 'worker'");
-  Require(
-      std::isfinite(repair_delay) && repair_delay >= 0 && repair_delay <= 3600,
-      "repair_delay = ", repair_delay, " must be in [0, 3600] s");
+  // Keyframes are kept at this size (StreamOptions::max_image_size).
+  Require(stream.mvs.max_image_size == 0 || stream.mvs.max_image_size >= 16,
+          "mvs.max_image_size = ", stream.mvs.max_image_size,
+          " must be 0 (as received) or >= 16");
   stream.Check();
 }
 
@@ -253,26 +249,15 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "s between diagnostics")
       .Above(0);
   registry
-      ->Add(key("error_throttle"), &o->error_throttle,
-            "s between repeated errors about the same problem")
-      .Min(0);
-  registry
-      ->Add(key("drop_window"), &o->drop_window,
-            "s, diagnostics WARN while drops happened within this window")
-      .Min(0.1)
-      .Max(86400);
-  registry
       ->Add(key("role"), &o->role,
             "standalone (select and reconstruct), selector (select, publish "
             "~keyframes for workers), worker (keyframes from `keyframes`)")
       .OneOf({"standalone", "selector", "worker"});
-  registry
-      ->Add(key("repair_delay"), &o->repair_delay,
-            "worker: s before an announced keyframe that did not arrive is "
-            "fetched from `get_keyframe`")
-      .Min(0)
-      .Max(3600);
   RegisterOptions(registry, prefix, &o->stream);
+  // The node keeps its keyframes at mvs/max_image_size (its Check()).
+  registry->Find(OptionRegistry::Join(prefix, "mvs.max_image_size"))
+      ->Min(16)
+      .OrZero();
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -354,6 +339,7 @@ DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params) {
   o.stream.use_tracker = o.sparse_source == "tracker" && o.role != "worker";
   o.stream.select_keyframes = o.role != "worker";
   o.stream.reconstruct = o.role != "selector";
+  o.stream.max_image_size = o.stream.mvs.max_image_size;
   CheckOptions(o, params);
   return o;
 }

@@ -599,11 +599,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   RegisterOptions(registry, prefix, &o->keyframes);
   RegisterOptions(registry, prefix, &o->store);
   registry
-      ->Add(key("max_image_size"), &o->max_image_size,
-            "longest image side kept, 0 = as received")
-      .Min(16)
-      .OrZero();
-  registry
       ->Add(key("num_threads"), &o->num_threads,
             "threads inside one reconstruction")
       .Min(1);

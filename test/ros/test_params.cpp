@@ -40,7 +40,8 @@ TEST(Params, ValuesReachTheCoreOptions) {
                     {"tracker/features/max_features", 1500},
                     {"max_keyframe_mb", 128.0},
                     {"mvs/mpgc/min_active_views", 2},
-                    {"mvs/sweep/below_seeds", 7}});
+                    {"mvs/sweep/below_seeds", 7},
+                    {"mvs/max_image_size", 320}});
   const DepthNodeOptions d = ReadDepthNodeOptions(p);
   EXPECT_EQ(d.world_frame, "map");
   EXPECT_DOUBLE_EQ(d.stream.keyframes.min_baseline, 0.2);
@@ -55,6 +56,10 @@ TEST(Params, ValuesReachTheCoreOptions) {
   EXPECT_DOUBLE_EQ(d.stream.store.max_mb, 128.0);
   EXPECT_EQ(d.stream.mvs.mpgc.min_active_views, 2);
   EXPECT_EQ(d.stream.mvs.sweep.below_seeds, 7);
+  // One size parameter: the working-size cap and the size keyframes are
+  // kept at.
+  EXPECT_EQ(d.stream.mvs.max_image_size, 320);
+  EXPECT_EQ(d.stream.max_image_size, 320);
 
   MapParamSource q({{"publish_period", 0.5},
                     {"output_path", std::string("/tmp/x.ply")},
@@ -219,6 +224,9 @@ TEST(Params, BadValuesNameTheParameter) {
             std::string::npos);
   EXPECT_NE(ErrorOf(MapParamSource({{"tf_timeout", 99.0}})).find("tf_timeout"),
             std::string::npos);
+  EXPECT_NE(ErrorOf(MapParamSource({{"mvs/max_image_size", 8}}))
+                .find("mvs.max_image_size"),
+            std::string::npos);
   MapParamSource f({{"fusion/min_support", 0}});
   EXPECT_THROW(ReadFusionNodeOptions(f), Error);
   // Reset policy of the fusion node: keep or reset, nothing else.
@@ -251,6 +259,13 @@ TEST(Params, UnknownParametersAreListed) {
                                              {"mvs/mpgc/window", 5}}))
           .size(),
       5u);
+  // Fixed in the node now (named constants) or one key for both sizes.
+  EXPECT_EQ(UnknownDepthNodeParams(MapParamSource({{"error_throttle", 5.0},
+                                                   {"drop_window", 60.0},
+                                                   {"repair_delay", 1.0},
+                                                   {"max_image_size", 320}}))
+                .size(),
+            4u);
   EXPECT_TRUE(
       UnknownFusionNodeParams(MapParamSource({{"fusion/min_support", 3}}))
           .empty());

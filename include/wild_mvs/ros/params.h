@@ -87,6 +87,13 @@ constexpr int kKeyframeQueueSize = 50;
 constexpr double kPoseSyncTolerance = 0.01;
 constexpr double kPoseMaxGap = 0.2;
 constexpr int kKeyframeHistory = 40;
+// The depth node's fixed housekeeping: seconds between repeated ROS_ERRORs
+// about the same kind of problem; seconds of drops that keep diagnostics
+// WARN (the counts are totals); seconds a worker waits for a keyframe the
+// index announced before fetching it from `get_keyframe`.
+constexpr double kErrorThrottle = 5.0;
+constexpr double kDropWindow = 60.0;
+constexpr double kRepairDelay = 1.0;
 
 // Options of the depth node (its ROS-side settings plus the stream
 // reconstructor's and the core's options).
@@ -135,13 +142,7 @@ struct DepthNodeOptions {
   std::string sparse_source = "tracker";
   int input_queue_size = 5;  // frames waiting for the front end; the oldest
                              // is dropped (counted) beyond it
-  double diagnostics_period = 1.0;  // s
-  // Stamps of frames whose images are wrongly encoded etc. are dropped with
-  // a ROS_ERROR at most every error_throttle seconds per kind of problem.
-  double error_throttle = 5.0;
-  // Diagnostics WARN while there were drops within the last drop_window s
-  // (the totals are kept too).
-  double drop_window = 60.0;
+  double diagnostics_period = 1.0;  // s between diagnostics, > 0
   // The node's part when depth maps are spread over several workers
   // (docs/ROS.md, "Several depth workers"):
   //   "standalone": selects keyframes from `image` and reconstructs the
@@ -154,10 +155,13 @@ struct DepthNodeOptions {
   //   (`image`, camera_info, pose and sparse_source are not used) and
   //   reconstructs the ones it owns. A gap in the keyframe ids, or a
   //   keyframe `keyframe_index` announced that has not arrived after
-  //   repair_delay, is fetched from the selector's `get_keyframe`.
+  //   kRepairDelay, is fetched from the selector's `get_keyframe`.
   std::string role = "standalone";
-  double repair_delay = 1.0;  // s, see role "worker"
-  StreamOptions stream;       // keyframes, store, scheduling, core options
+  // Keyframes, store, scheduling, core options. stream.max_image_size is
+  // stream.mvs.max_image_size (ReadDepthNodeOptions): one parameter,
+  // mvs/max_image_size, sets the size keyframes are kept at and caps the
+  // working size.
+  StreamOptions stream;
   void Check() const;
 };
 
@@ -172,8 +176,10 @@ struct FusionNodeOptions {
   std::string output_path;      // PLY written on shutdown when set
   int input_queue_size = 10;    // depth views waiting to be fused
   double diagnostics_period = 1.0;
-  double error_throttle = 5.0;
-  double drop_window = 60.0;  // s, see DepthNodeOptions
+  double error_throttle = 5.0;  // s between repeated errors about a problem
+  // Diagnostics WARN while there were drops within the last drop_window s
+  // (the totals are kept too).
+  double drop_window = 60.0;
   // Cloud published for rviz: at most this many points (uniform subsample);
   // the saved PLY always has all points. 0 = no limit.
   int max_published_points = 500000;

@@ -66,7 +66,9 @@ struct StreamOptions {
   // keyframe, or when mvs.global.num_neighbors good neighbours are there.
   int lookahead = 2;
   double idle_flush = 1.0;
-  // Longest image side used (input downscaled at arrival); 0 = as received.
+  // Longest image side kept, pixels, 0 or >= 16 (input downscaled at
+  // arrival); 0 = as received. Not a parameter of its own: the depth node
+  // sets it from mvs.max_image_size (the working-size cap of the core).
   int max_image_size = 0;
   // A camera jump larger than this (metres) between consecutive frames less
   // than 1 s apart is a pose reset (tracking lost, relocalised): the stream
@@ -78,7 +80,8 @@ struct StreamOptions {
   void Check() const;
 };
 // Registers the fields under `prefix` (option_registry.h); the depth node
-// uses prefix "" (num_threads, ..., mvs/..., tracker/...).
+// uses prefix "" (num_threads, ..., mvs/..., tracker/...). max_image_size
+// and the fields the node's role sets are not registered.
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      StreamOptions* options);
 
