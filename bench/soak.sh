@@ -62,7 +62,7 @@ for _ in $(seq 60); do rosparam list >/dev/null 2>&1 && break; sleep 0.5; done
 rosparam load "$WILD_MVS_ROOT/config/depth_node.yaml" /depth_node
 rosparam load "$WILD_MVS_ROOT/config/fusion_node.yaml" /fusion_node
 rosparam load "$WILD_MVS_ROOT/config/sample.yaml" /
-rosparam set /depth_node/max_image_size "$MAX_IMAGE_SIZE"
+rosparam set /depth_node/mvs/max_image_size "$MAX_IMAGE_SIZE"
 rosparam set /depth_node/diagnostics_period 2.0
 rosparam set /fusion_node/diagnostics_period 2.0
 rosparam set /fusion_node/output_path "$OUT/cloud.ply"

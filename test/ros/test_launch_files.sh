@@ -41,6 +41,10 @@ has "$params" "/depth_node/image_transport: raw" "$L transport"
 has "$params" "/depth_node/pose_source: tf" "$L pose_source"
 has "$params" "/depth_node/keyframe_min_baseline: 0.05" "$L config default (node defaults only)"
 has "$params" "/depth_node/camera_frame: ''" "$L camera_frame default (the image header's frame)"
+has "$params" "/depth_node/mvs/max_image_size: 0" "$L max_image_size default (node defaults)"
+hasnt "$params" "/depth_node/max_image_size:" "$L one size parameter (mvs/max_image_size)"
+params=$(roslaunch --dump-params wild_mvs $L bag:=/tmp/a.bag max_image_size:=320)
+has "$params" "/depth_node/mvs/max_image_size: 320" "$L max_image_size"
 
 # A user's own bag: other topics, transport, frames, pose topic, config.
 A=(bag:=/tmp/a.bag image:=/cam0/color/image_raw transport:=compressed world_frame:=map
