@@ -559,11 +559,24 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   if (mpgc_.explain_margin >= 0 && num_active_ >= 2 &&
       mean_ncc < mpgc_.explain_below_ncc) {
     // Not even the best view explains R's window as well as the views
-    // explain each other's.
+    // explain each other's. Every NCC is corrected for what the two
+    // windows' noise takes from it (image_noise.h): R's window, sampled at
+    // pixel centres, and a dark or overcast view's windows are noisier than
+    // the others, which lowers their NCCs whatever they see.
+    double w2 = 0;
+    for (int i = 0; i < npix_; ++i) w2 += weight_[i] * weight_[i];
+    double ref_mean = 0;
+    for (int c = 0; c < channels_; ++c) ref_mean += ref_wmean_[c];
+    const double ref_sigma = ctx_.ref_noise.Sigma(ref_mean / channels_);
+    const double r_ref = WindowReliability(ref_saa_, ref_sigma * ref_sigma,
+                                           channels_, weight_sum_, w2);
+    double reliability[kMaxActive];
+    pair_ncc = MeanPairwiseNcc(w2, reliability);
     double best = -1;
     for (int a = 0; a < num_active_; ++a)
-      best = std::max(best, slots_[active_slot_[a]].ncc);
-    pair_ncc = MeanPairwiseNcc();
+      best =
+          std::max(best, std::min(1.0, slots_[active_slot_[a]].ncc /
+                                           std::sqrt(r_ref * reliability[a])));
     explained = best >= pair_ncc - mpgc_.explain_margin;
     if (!explained && !mpgc_.explain_keeps_match) return false;
   }
@@ -585,24 +598,33 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   return true;
 }
 
-double PatchMatcher::MeanPairwiseNcc() const {
+double PatchMatcher::MeanPairwiseNcc(double w2, double* reliability) const {
   if (num_active_ < 2) return 1;
   // Mean-free copies of the active windows (per channel).
   float c[kMaxActive][mpgc_kernels::kWindowFloats];
   double ss[kMaxActive];
   for (int a = 0; a < num_active_; ++a) {
-    const float* v = slots_[active_slot_[a]].val;
+    const SlotData& sl = slots_[active_slot_[a]];
+    const float* v = sl.val;
     ss[a] = 0;
+    double brightness = 0;
     for (int ch = 0; ch < channels_; ++ch) {
       double m = 0;
       for (int i = 0; i < npix_; ++i) m += weight_[i] * v[4 * i + ch];
       m /= weight_sum_;
+      brightness += m;
       for (int i = 0; i < npix_; ++i) {
         const float d = static_cast<float>(v[4 * i + ch] - m);
         c[a][4 * i + ch] = d;
         ss[a] += weight_[i] * d * d;
       }
     }
+    // The neighbours' windows are bilinear samples.
+    const double sigma =
+        ctx_.views[sl.view].noise.Sigma(brightness / channels_);
+    reliability[a] =
+        WindowReliability(ss[a], kBilinearNoiseFactor * sigma * sigma,
+                          channels_, weight_sum_, w2);
   }
   const double floor = kNccMinVariance * weight_sum_ * channels_;
   double sum = 0;
@@ -613,8 +635,11 @@ double PatchMatcher::MeanPairwiseNcc() const {
       for (int ch = 0; ch < channels_; ++ch)
         for (int i = 0; i < npix_; ++i)
           sab += weight_[i] * c[a][4 * i + ch] * c[b][4 * i + ch];
-      sum += (ss[a] < floor || ss[b] < floor) ? -1
-                                              : sab / std::sqrt(ss[a] * ss[b]);
+      sum +=
+          (ss[a] < floor || ss[b] < floor)
+              ? -1
+              : std::min(1.0, sab / std::sqrt(ss[a] * ss[b] * reliability[a] *
+                                              reliability[b]));
       ++pairs;
     }
   return sum / pairs;

@@ -51,7 +51,8 @@ struct MpgcOptions {
   int min_active_views = 3;  // fail with fewer active views, [1, kMaxActive]
   // A converged match is unexplained when the best NCC of an active view
   // with R is more than this below the active views' mean NCC with each
-  // other, [0, 2]; -1 = off (paper).
+  // other, both corrected for the windows' noise (image_noise.h), [0, 2];
+  // -1 = off (paper).
   double explain_margin = 0;
   // Only matches whose mean NCC with R is below this are tested, [-1, 1.5].
   double explain_below_ncc = 0.8;
@@ -109,8 +110,8 @@ struct PatchResult {
   double depth = 0;                  // z of the pixel centre
   Eigen::Vector3d normal{0, 0, -1};  // camera frame, facing the camera
   double confidence = 0;             // mean NCC over A mapped to [0, 1]
-  // Mean NCC of A's views with each other (computed when explain_margin is
-  // on, else NaN).
+  // Mean NCC of A's views with each other, corrected for noise (computed
+  // when the explain test ran, else NaN).
   double pair_ncc = std::numeric_limits<double>::quiet_NaN();
   // False when the explain test failed and explain_keeps_match kept the
   // match: growth does not expand from it.
@@ -172,8 +173,11 @@ class PatchMatcher {
   bool FullStep(bool fit_normal, bool fit_scale);
   bool MakeResult(int iterations, PatchResult* out) const;
   // Mean NCC of the active views' windows with each other (pairs of A; the
-  // channels pooled as in SlotNcc). 1 with fewer than two views.
-  double MeanPairwiseNcc() const;
+  // channels pooled as in SlotNcc), each corrected for the two windows'
+  // noise (image_noise.h) and capped at 1; 1 with fewer than two views.
+  // w2: the sum of the squared window weights. reliability[a]: A[a]'s
+  // window's reliability.
+  double MeanPairwiseNcc(double w2, double* reliability) const;
   void SetBilateralWeights();
   void Note(int iteration, MatchTrace::Kind kind, int view) {
     if (trace_) trace_->events.push_back({iteration, kind, view});

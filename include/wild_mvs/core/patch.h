@@ -18,6 +18,7 @@
 
 #include "wild_mvs/core/ablation.h"
 #include "wild_mvs/core/camera.h"
+#include "wild_mvs/core/image_noise.h"
 
 namespace wild_mvs {
 
@@ -37,6 +38,7 @@ struct MatchImage {
 struct PatchView {
   int scene_view = -1;
   MatchImage image;
+  NoiseProfile noise;  // image's noise (zero = none known)
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();  // see the file comment
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   Eigen::Vector3d epipole = Eigen::Vector3d::Zero();  // V's centre in R
@@ -47,6 +49,7 @@ struct PatchView {
 struct PatchContext {
   Camera ref_camera;  // R at its working resolution
   MatchImage ref_image;
+  NoiseProfile ref_noise;        // ref_image's noise (zero = none known)
   std::vector<PatchView> views;  // the neighbourhood N (<= kMaxNeighbors)
   int window = 5;                // n (odd)
   // Parts of the method turned off (local view selection, normal, colour
