@@ -3,8 +3,8 @@
 """Ends a bag reconstruction (launch/reconstruct_bag.launch) whatever the
 topics are called: it only reads /diagnostics. Once the depth node's
 "frames received" went above 0 and then stopped increasing for ~image_idle
-s (the bag is played), its "reconstructions pending", "input queue length"
-and "keyframes waiting" are 0, the fusion node's "input queue length" and
+s (the bag is played), its "reconstructions pending", "input queue length",
+"keyframes waiting" and "revisions to come" are 0, the fusion node's "input queue length" and
 "views waiting for order" are 0, and no counter of either node changed for
 ~view_idle s, it calls the fusion node's ~save service and exits; the launch
 file marks this node required, so the whole launch ends after it.
@@ -27,10 +27,11 @@ import rospy
 from diagnostic_msgs.msg import DiagnosticArray
 from wild_mvs.srv import SaveCloud
 
-DEPTH_BUSY = ("reconstructions pending", "input queue length", "keyframes waiting")
+DEPTH_BUSY = ("reconstructions pending", "input queue length", "keyframes waiting",
+              "revisions to come")
 FUSION_BUSY = ("input queue length", "views waiting for order")
 DEPTH_COUNTERS = ("frames received", "keyframes created", "depth maps",
-                  "depth maps redone", "reconstructions failed")
+                  "depth maps revised", "reconstructions failed")
 FUSION_COUNTERS = ("views received", "views fused")
 
 

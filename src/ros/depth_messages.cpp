@@ -45,6 +45,7 @@ void DepthOutputs::Publish(const StreamResult& r) {
   }
   view->worker_index = worker_index_;
   view->revision = r.revision;
+  view->final_revision = r.final_revision;
   FillDepthView(r.depth, world_frame_, view.get());
   if (!r.image.empty())
     view->image = ColorToMsg(r.image, r.depth.width(), r.depth.height());
@@ -140,7 +141,8 @@ void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
   stat.add("depth maps", s.reconstructed);
   stat.add("depth maps running", s.running);
   stat.add("depth maps cancelled", s.cancelled);
-  stat.add("depth maps redone", s.redone);
+  stat.add("depth maps revised", s.revised);
+  stat.add("revisions to come", s.unrevised);
   stat.add("reconstructions failed", s.failed);
   stat.add("keyframes evicted before reconstruction", s.evicted_waiting);
   stat.add("stream resets", s.resets);

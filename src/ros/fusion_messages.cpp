@@ -22,6 +22,8 @@ FusionView FusionViewFromMsg(const wild_mvs::DepthView& msg) {
   for (const ros::Time& s : msg.neighbor_stamps)
     view.neighbor_stamps_ns.push_back(s.toNSec());
   view.stamp_ns = msg.header.stamp.toNSec();
+  view.revision = static_cast<int>(msg.revision);
+  view.final_revision = msg.final_revision;
   view.arrived = std::chrono::steady_clock::now();
   return view;
 }
@@ -29,6 +31,7 @@ FusionView FusionViewFromMsg(const wild_mvs::DepthView& msg) {
 FusionSessionOptions SessionOptions(const FusionNodeOptions& o) {
   FusionSessionOptions so;
   so.reorder_timeout = o.reorder_timeout;
+  so.revision_timeout = o.revision_timeout;
   so.on_new_session = o.on_new_session;
   so.output_path = o.output_path;
   so.map_store_mb = o.map_store_mb;
@@ -51,6 +54,7 @@ void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
   stat.add("input queue length", queued);
   stat.add("views waiting for order", s.waiting);
   stat.add("views fused", s.fused);
+  stat.add("revisions replaced", s.revisions_replaced);
   stat.add("revisions ignored", s.revisions_ignored);
   stat.add("points", s.fusion.points);
   stat.add("pending samples", s.fusion.pending);

@@ -177,6 +177,8 @@ void FusionNodeOptions::Check() const {
           "max_published_points = ", max_published_points, " must be >= 0");
   Require(std::isfinite(reorder_timeout) && reorder_timeout >= 0,
           "reorder_timeout = ", reorder_timeout, " must be >= 0");
+  Require(std::isfinite(revision_timeout) && revision_timeout >= 0,
+          "revision_timeout = ", revision_timeout, " must be >= 0");
   Require(on_new_session == "keep" || on_new_session == "reset",
           "on_new_session = '", on_new_session, "' must be 'keep' or 'reset'");
   Require(std::isfinite(map_store_mb) && map_store_mb > 0,
@@ -285,6 +287,11 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry
       ->Add(key("reorder_timeout"), &o->reorder_timeout,
             "s a view waits for a missing earlier keyframe (several workers)")
+      .Min(0);
+  registry
+      ->Add(key("revision_timeout"), &o->revision_timeout,
+            "s a view waits for its keyframe's final revision before it is "
+            "fused as it is (0 = never waits)")
       .Min(0);
   registry
       ->Add(key("on_new_session"), &o->on_new_session,

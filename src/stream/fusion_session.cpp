@@ -15,6 +15,15 @@ void ReorderBuffer::Insert(FusionView view) {
   waiting_[key] = std::move(view);
 }
 
+bool ReorderBuffer::Replace(FusionView view) {
+  auto it = waiting_.find(view.stamp_ns);
+  if (it == waiting_.end() || view.revision <= it->second.revision)
+    return false;
+  view.arrived = it->second.arrived;
+  it->second = std::move(view);
+  return true;
+}
+
 bool ReorderBuffer::PopReady(Clock::time_point now, FusionView* out) {
   if (waiting_.empty()) return false;
   auto it = waiting_.begin();
@@ -25,6 +34,15 @@ bool ReorderBuffer::PopReady(Clock::time_point now, FusionView* out) {
           : (Seen(v.session_ns) || v.keyframe_id == 0);
   const double waited = std::chrono::duration<double>(now - v.arrived).count();
   if (!next && waited < timeout_) return false;
+  // A revision never comes once the depth node started another session
+  // (its reset forgets the revisions to come).
+  auto other_session = [&] {
+    for (const auto& [key, w] : waiting_)
+      if (w.session_ns != v.session_ns) return true;
+    return false;
+  };
+  if (!v.final_revision && waited < revision_timeout_ && !other_session())
+    return false;
   *out = std::move(it->second);
   waiting_.erase(it);
   return true;
@@ -51,6 +69,8 @@ void ReorderBuffer::Fused(uint64_t session, uint32_t keyframe_id) {
 void FusionSessionOptions::Check() const {
   Require(std::isfinite(reorder_timeout) && reorder_timeout >= 0,
           "reorder_timeout = ", reorder_timeout, " must be >= 0");
+  Require(std::isfinite(revision_timeout) && revision_timeout >= 0,
+          "revision_timeout = ", revision_timeout, " must be >= 0");
   Require(on_new_session == "keep" || on_new_session == "reset",
           "on_new_session = '", on_new_session, "' must be 'keep' or 'reset'");
   Require(std::isfinite(map_store_mb) && map_store_mb > 0,
@@ -64,7 +84,7 @@ FusionSession::FusionSession(const FusionSessionOptions& options,
       on_drop_(std::move(on_drop)),
       on_log_(std::move(on_log)),
       store_(options.map_store_mb, options.spill_dir),
-      reorder_(options.reorder_timeout) {
+      reorder_(options.reorder_timeout, options.revision_timeout) {
   NewFusionLocked();
   SnapshotLocked();
 }
@@ -78,12 +98,21 @@ void FusionSession::NewFusionLocked() {
 bool FusionSession::Add(FusionView view) {
   std::lock_guard<std::mutex> lock(mutex_);
   const uint64_t key = view.stamp_ns;
-  if (view_of_stamp_.count(key) || reorder_.Contains(key)) {
-    ++revisions_ignored_;  // fusion is incremental: first result stays
+  if (view_of_stamp_.count(key)) {
+    ++revisions_ignored_;  // fused already: the fusion is incremental
     SnapshotLocked();
     return false;
   }
-  reorder_.Insert(std::move(view));
+  if (reorder_.Contains(key)) {
+    if (!reorder_.Replace(std::move(view))) {
+      ++revisions_ignored_;
+      SnapshotLocked();
+      return false;
+    }
+    ++revisions_replaced_;
+  } else {
+    reorder_.Insert(std::move(view));
+  }
   FuseReadyLocked();
   SnapshotLocked();
   return true;
@@ -138,6 +167,7 @@ void FusionSession::SnapshotLocked() {
   s.waiting = reorder_.size();
   s.fused = fused_;
   s.revisions_ignored = revisions_ignored_;
+  s.revisions_replaced = revisions_replaced_;
   s.spilled = store_.spilled();
   s.resets = resets_;
   s.sessions = sessions_;

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <unordered_map>
 
+#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/global_view_selection.h"
 
 namespace wild_mvs {
@@ -86,6 +87,9 @@ void StreamReconstructor::ClearLocked() {
   points_.clear();
   stamped_points_.clear();
   in_flight_.clear();
+  maps_.clear();
+  unrevised_.clear();
+  revising_.clear();
   ++generation_;
   next_id_ = 0;  // ids restart in the new session
   session_ = -1;
@@ -216,8 +220,10 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
         options_.reconstruct &&
         KeyframeOwner(stamp_ns, options_.worker_count) == options_.worker_index;
     evicted = store_.Add(kf);
-    for (const KeyframePtr& e : evicted)
+    for (const KeyframePtr& e : evicted) {
       if (!e->done() && !in_flight_.count(e->id)) ++stats_.evicted_waiting;
+      ForgetLocked(e->id);
+    }
     ++stats_.keyframes_total;
     last_keyframe_wall_ = WallSeconds();
     idle_scheduled_ = false;
@@ -350,9 +356,14 @@ StreamReconstructor::Neighborhood StreamReconstructor::Evaluate(
 
 void StreamReconstructor::ScheduleLocked() {
   ready_waiting_ = 0;
-  if (stopping_ || store_.size() < 2) return;
   const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
   if (idle) idle_scheduled_ = true;
+  ScheduleMatchingLocked(idle);
+  ScheduleRevisionsLocked(idle);
+}
+
+void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
+  if (stopping_ || store_.size() < 2) return;
   // The snapshot (every keyframe and sparse point) only when some keyframe
   // could be scheduled.
   auto schedulable = [this](const KeyframePtr& kf) {
@@ -386,6 +397,91 @@ void StreamReconstructor::ScheduleLocked() {
     const uint64_t gen = generation_;
     dispatcher_->Submit([this, id, gen] { RunReconstruction(id, gen); });
   }
+}
+
+void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
+  if (stopping_) return;
+  for (const auto& [id, first] : unrevised_) {
+    if (revising_.count(id)) continue;
+    // Every neighbour it was matched against is done (a neighbour no longer
+    // held is done too); at the idle flush, with nothing being matched,
+    // neighbours that cannot be matched yet are not waited for.
+    bool ready = true;
+    for (uint32_t n : first.neighbor_ids) {
+      const KeyframePtr k = store_.Get(n);
+      if (k && (!k->done() || in_flight_.count(n))) ready = false;
+    }
+    if (!ready && !(idle && in_flight_.empty())) continue;
+    revising_.insert(id);
+    const uint64_t gen = generation_;
+    const uint32_t rid = id;
+    dispatcher_->Submit([this, rid, gen] { RunRevision(rid, gen); });
+  }
+}
+
+void StreamReconstructor::ForgetLocked(uint32_t id) {
+  maps_.erase(id);
+  unrevised_.erase(id);
+}
+
+void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
+  StreamResult result;
+  std::vector<std::shared_ptr<const DepthMap>> held;
+  GeometricConsistencyOptions consistency;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = unrevised_.find(id);
+    if (stopping_ || generation != generation_ || it == unrevised_.end()) {
+      revising_.erase(id);
+      idle_cv_.notify_all();
+      return;
+    }
+    result = it->second;
+    for (uint32_t n : result.neighbor_ids) {
+      auto m = maps_.find(n);
+      if (m != maps_.end()) held.push_back(m->second);
+    }
+    consistency = options_.mvs.consistency;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  // The first result's arrays were delivered: the revision works on copies.
+  result.depth.depth = result.depth.depth.clone();
+  result.depth.normal = result.depth.normal.clone();
+  result.depth.confidence = result.depth.confidence.clone();
+  std::vector<const DepthMap*> neighbors;
+  for (const auto& m : held) neighbors.push_back(m.get());
+  std::string error;
+  try {
+    ConsistencyStats stats;
+    FilterByConsistency(&result.depth, neighbors, consistency, &stats);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  result.revision = 1;
+  result.final_revision = true;
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
+          .count();
+  bool deliver = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    revising_.erase(id);
+    unrevised_.erase(id);
+    if (generation != generation_) {
+      ++stats_.stale_results;
+    } else if (!error.empty()) {
+      ++stats_.failed;
+    } else {
+      ++stats_.revised;
+      deliver = true;
+    }
+  }
+  if (!error.empty() && on_error_)
+    on_error_(Msg("keyframe ", id, ": revision failed: ", error));
+  if (deliver && on_result_) on_result_(result);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ScheduleLocked();
+  idle_cv_.notify_all();
 }
 
 void StreamReconstructor::Tick() {
@@ -480,8 +576,17 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       ++stats_.failed;
       ++kf->reconstructions;  // do not retry in a loop
     } else {
-      result.revision = kf->reconstructions;
-      if (kf->reconstructions > 0) ++stats_.redone;
+      result.revision = 0;
+      // With the consistency step a revision follows (ScheduleRevisions).
+      result.final_revision = !mvs.ablation.consistency;
+      if (!result.final_revision) {
+        auto depth_only = std::make_shared<DepthMap>();
+        depth_only->view = result.depth.view;
+        depth_only->camera = result.depth.camera;
+        depth_only->depth = result.depth.depth;
+        maps_[id] = std::move(depth_only);
+        unrevised_[id] = result;
+      }
       ++kf->reconstructions;
       kf->neighbor_score = score;
       ++stats_.reconstructed;
@@ -501,7 +606,8 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
 
 void StreamReconstructor::WaitIdle() {
   std::unique_lock<std::mutex> lock(mutex_);
-  idle_cv_.wait(lock, [this] { return in_flight_.empty(); });
+  idle_cv_.wait(lock,
+                [this] { return in_flight_.empty() && revising_.empty(); });
 }
 
 StreamStats StreamReconstructor::Stats() const {
@@ -510,6 +616,7 @@ StreamStats StreamReconstructor::Stats() const {
   s.keyframes = store_.size();
   s.store_mb = store_.bytes() / (1024.0 * 1024.0);
   s.pending = static_cast<int>(in_flight_.size());
+  s.unrevised = static_cast<int>(unrevised_.size());
   s.waiting = ready_waiting_;
   s.sparse_points = points_.size() + stamped_points_.size();
   s.session = session_;

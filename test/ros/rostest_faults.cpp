@@ -328,15 +328,18 @@ class Scenario {
     if (!Require(ros::param::get("/fusion_node/output_path", out),
                  "no /fusion_node/output_path"))
       return false;
-    // The fusion node may still be fusing the last depth maps: read its
-    // point count once it has stopped changing (two diagnostics reports
-    // apart).
+    // The fusion node may still be fusing the last depth maps, or holding
+    // first revisions for their final one (revision_timeout): read its
+    // point count once nothing waits and it has stopped changing (two
+    // diagnostics reports apart).
     points = diag_.Get("fusion_node: ", "points");
     WaitFor(
         [&] {
           ros::WallDuration(2.5).sleep();
           const long now = diag_.Get("fusion_node: ", "points");
-          const bool stable = now == points;
+          const bool stable =
+              now == points &&
+              diag_.Get("fusion_node: ", "views waiting for order") == 0;
           points = now;
           return stable;
         },

@@ -7,7 +7,9 @@
 // depth_image_proc's point_cloud_xyz, once; test cases check on what came:
 //   - every output header stamp is bit-for-bit an input image stamp;
 //   - one depth map per view (the keyframe selection takes one frame of
-//     each lingering group), matching the exact ground truth;
+//     each lingering group), matching the exact ground truth, its final
+//     revision as accurate as the offline pipeline's map on the same
+//     images;
 //   - output frame ids have no leading '/';
 //   - the final fused cloud comes after the bag ended (/clock stopped) and
 //     carries the newest fused view's stamp;
@@ -38,7 +40,11 @@
 #include "ros_test_scene.h"
 #include "rostest_util.h"
 #include "test_paths.h"
+#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/metrics.h"
+#include "wild_mvs/core/reconstruct_view.h"
+#include "wild_mvs/core/sparse_tracker.h"
+#include "wild_mvs/core/thread_pool.h"
 #include "wild_mvs/ros/conversions.h"
 
 namespace wild_mvs {
@@ -150,6 +156,9 @@ class Playback {
           if (views.empty() &&
               Clock::now() > bag_ended + std::chrono::seconds(90))
             return true;
+          // Every view's final revision (its consistency step) came.
+          for (const auto& [ns, m] : views)
+            if (!m->final_revision) return false;
           return ViewsCovered().size() >= static_cast<size_t>(num_views) &&
                  depth_images.size() >= views.size() &&
                  xyz_points.size() >= views.size() &&
@@ -221,6 +230,7 @@ class Playback {
   uint32_t view_publishers = 0;
   std::vector<Received> received;  // every output header seen
   std::map<uint64_t, wild_mvs::DepthViewConstPtr> views;  // by stamp ns
+  std::map<uint64_t, wild_mvs::DepthViewConstPtr> first_views;  // revision 0
   std::map<uint64_t, sensor_msgs::ImageConstPtr> depth_images;
   std::map<uint64_t, sensor_msgs::PointCloud2ConstPtr> node_points, xyz_points;
   int confidence_count = 0, info_count = 0;
@@ -246,6 +256,7 @@ class Playback {
           note("/depth_node/depth_view depth", m->depth.header);
           note("/depth_node/depth_view camera_info", m->camera_info.header);
           views[m->header.stamp.toNSec()] = m;
+          if (m->revision == 0) first_views[m->header.stamp.toNSec()] = m;
           last_view_at = Clock::now();
         });
     s_depth_ = nh_.subscribe<sensor_msgs::Image>(
@@ -434,6 +445,84 @@ TEST_F(RealBag, DepthMapsMatchTheGroundTruth) {
     EXPECT_LT(m.median_rel_error, mono ? 0.02 : 0.01)
         << "view " << v << ": " << m.ToString();
   }
+}
+
+// Pooled over the views: fraction of the ground truth with an estimate, of
+// the estimates within 1 % and off by more than 5 %.
+struct Pooled {
+  double gt = 0, evaluated = 0, in1 = 0, off5 = 0;
+  void Add(const DepthMetrics& m) {
+    gt += m.gt_valid;
+    evaluated += m.evaluated;
+    in1 += m.relative_accuracy[0] * m.evaluated;
+    off5 += (1 - m.relative_accuracy[2]) * m.evaluated;
+  }
+  double coverage() const { return gt > 0 ? evaluated / gt : 0; }
+  double within1() const { return evaluated > 0 ? in1 / evaluated : 0; }
+  double off5pc() const { return evaluated > 0 ? off5 / evaluated : 0; }
+};
+
+// The live path runs the offline pipeline's steps (matching, then the
+// consistency step as a revision): its final maps are as accurate as the
+// offline ones on the same images (sparse tracks from the known poses,
+// every view matched against its best neighbours, consistency filter).
+TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
+  const Playback& p = *playback_;
+  ASSERT_FALSE(p.views.empty());
+  auto score = [&p](const wild_mvs::DepthView& msg, Pooled* pooled) {
+    const int v = p.ViewOf(msg.header.stamp);
+    if (v < 0) return;
+    cv::Mat d = ros1::FloatImageFromMsg(msg.depth, 1, "depth");
+    d.forEach<float>([](float& x, const int*) {
+      if (std::isnan(x)) x = 0;
+    });
+    pooled->Add(EvaluateDepth(d, CameraOf(msg), p.scene.depth[v],
+                              p.bag.view_cameras[v]));
+  };
+  Pooled live, first;
+  for (const auto& [ns, msg] : p.views) {
+    EXPECT_TRUE(msg->final_revision) << "view " << p.ViewOf(msg->header.stamp);
+    score(*msg, &live);
+  }
+  for (const auto& [ns, msg] : p.first_views) score(*msg, &first);
+  // Offline: as `wild_mvs reconstruct` does it, with the node's settings.
+  Scene scene = p.scene.scene;
+  for (size_t v = 0; v < scene.views.size(); ++v)
+    scene.views[v].camera = p.bag.view_cameras[v];
+  MvsOptions mvs;
+  ros::param::get("/depth_node/mvs/global/num_neighbors",
+                  mvs.global.num_neighbors);
+  ThreadPool pool(2);
+  const SyntheticScene& s = p.scene;
+  ImageCache images([&s](int v) { return s.images[v]; }, 256);
+  scene.points = ComputeSparseTracks(scene, images, TrackerOptions(), &pool,
+                                     nullptr);
+  std::vector<DepthMap> raw(scene.views.size());
+  for (size_t v = 0; v < scene.views.size(); ++v)
+    raw[v] = ReconstructView(scene, static_cast<int>(v), images, mvs, &pool,
+                             nullptr, cv::Mat());
+  Pooled offline;
+  for (size_t v = 0; v < scene.views.size(); ++v) {
+    DepthMap m = raw[v];
+    m.depth = raw[v].depth.clone();
+    std::vector<const DepthMap*> neighbors;
+    for (int n : raw[v].neighbors) neighbors.push_back(&raw[n]);
+    ConsistencyStats stats;
+    FilterByConsistency(&m, neighbors, mvs.consistency, &stats);
+    offline.Add(EvaluateDepth(m.depth, m.camera, p.scene.depth[v],
+                              p.bag.view_cameras[v]));
+  }
+  std::printf(
+      "[real_bag] %s: coverage, within 1 %%, off > 5 %%: live first "
+      "revisions %.3f, %.3f, %.2f %%; final %.3f, %.3f, %.2f %%; offline "
+      "%.3f, %.3f, %.2f %%\n",
+      p.variant.c_str(), first.coverage(), first.within1(),
+      100 * first.off5pc(), live.coverage(), live.within1(),
+      100 * live.off5pc(), offline.coverage(), offline.within1(),
+      100 * offline.off5pc());
+  EXPECT_GT(live.within1(), offline.within1() - 0.01);
+  EXPECT_LT(live.off5pc(), offline.off5pc() + 0.005);
+  EXPECT_GT(live.coverage(), offline.coverage() - 0.1);
 }
 
 TEST_F(RealBag, LingeringFramesGiveOneKeyframePerView) {

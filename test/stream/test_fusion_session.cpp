@@ -49,7 +49,7 @@ FusionView SceneView(int i, uint64_t session, uint32_t id) {
 }
 
 TEST(ReorderBuffer, ReleasesViewsInKeyframeOrder) {
-  ReorderBuffer b(2.0);
+  ReorderBuffer b(2.0, 30.0);
   const Clock::time_point t0 = Clock::now();
   const uint64_t S = 77;
   FusionView out;
@@ -99,6 +99,48 @@ TEST(ReorderBuffer, ReleasesViewsInKeyframeOrder) {
   EXPECT_EQ(b.size(), 0u);
 }
 
+// A first revision that is not final waits for its final revision, which
+// replaces it, or at most revision_timeout; an earlier revision never
+// replaces a later one.
+TEST(ReorderBuffer, WaitsForTheFinalRevisionAndTakesIt) {
+  ReorderBuffer b(2.0, 30.0);
+  const Clock::time_point t0 = Clock::now();
+  const uint64_t S = 5;
+  FusionView out;
+  FusionView first = MakeView(S, 0, 100, t0);
+  first.final_revision = false;
+  b.Insert(first);
+  EXPECT_FALSE(b.PopReady(t0 + std::chrono::seconds(29), &out));
+  FusionView revised = MakeView(S, 0, 100, t0 + std::chrono::seconds(10));
+  revised.revision = 1;
+  revised.map.view = 42;  // marks it
+  EXPECT_TRUE(b.Replace(revised));
+  EXPECT_FALSE(b.Replace(first));  // revision 0 after 1: not taken
+  EXPECT_EQ(b.size(), 1u);
+  ASSERT_TRUE(b.PopReady(t0 + std::chrono::seconds(10), &out));
+  EXPECT_EQ(out.revision, 1);
+  EXPECT_EQ(out.map.view, 42);
+  EXPECT_EQ(out.arrived, t0);  // the first one's arrival is kept
+  b.StartSession(S);
+  b.Fused(S, 0);
+  // Keyframe 1's revision never comes: it goes after revision_timeout.
+  FusionView lone = MakeView(S, 1, 101, t0);
+  lone.final_revision = false;
+  b.Insert(lone);
+  EXPECT_FALSE(b.PopReady(t0 + std::chrono::milliseconds(29999), &out));
+  ASSERT_TRUE(b.PopReady(t0 + std::chrono::seconds(30), &out));
+  EXPECT_EQ(out.revision, 0);
+  b.Fused(S, 1);
+  // ... nor once a view of another session waits (the depth node reset).
+  FusionView old = MakeView(S, 2, 102, t0);
+  old.final_revision = false;
+  b.Insert(old);
+  EXPECT_FALSE(b.PopReady(t0, &out));
+  b.Insert(MakeView(S + 1, 0, 200, t0));
+  ASSERT_TRUE(b.PopReady(t0, &out));
+  EXPECT_EQ(out.stamp_ns, 102u);
+}
+
 struct Recorder {
   std::vector<std::string> drops, logs;
   FusionSession::DropCallback Drop() {
@@ -120,7 +162,7 @@ FusionSessionOptions SessionOptions() {
   return o;
 }
 
-TEST(FusionSession, FusesInOrderIgnoresRevisionsAndReportsTheCloud) {
+TEST(FusionSession, FusesInOrderTakesWaitingRevisionsAndReportsTheCloud) {
   Recorder r;
   FusionSession f(SessionOptions(), r.Drop(), r.Log());
   uint64_t version = 0, stamp = 0;
@@ -134,11 +176,25 @@ TEST(FusionSession, FusesInOrderIgnoresRevisionsAndReportsTheCloud) {
   EXPECT_TRUE(f.Add(SceneView(0, 0, 0)));
   EXPECT_EQ(f.Stats().fused, 3u);
   EXPECT_EQ(f.Stats().waiting, 0u);
-  for (int i = 3; i < kViews; ++i) EXPECT_TRUE(f.Add(SceneView(i, 0, i)));
-  // A revision (same stamp) is ignored, waiting or fused.
-  EXPECT_FALSE(f.Add(SceneView(4, 0, 4)));
+  // Keyframe 3 announces a revision: it and every later keyframe wait.
+  FusionView first3 = SceneView(3, 0, 3);
+  first3.final_revision = false;
+  EXPECT_TRUE(f.Add(first3));
+  for (int i = 4; i < kViews; ++i) EXPECT_TRUE(f.Add(SceneView(i, 0, i)));
+  EXPECT_EQ(f.Stats().fused, 3u);
+  EXPECT_EQ(f.Stats().waiting, size_t(kViews - 3));
+  // Its final revision replaces it; then all of them are fused.
+  FusionView final3 = SceneView(3, 0, 3);
+  final3.revision = 1;
+  EXPECT_TRUE(f.Add(final3));
+  EXPECT_EQ(f.Stats().fused, uint64_t(kViews));
+  // A revision of a view fused already is ignored.
+  FusionView late = SceneView(4, 0, 4);
+  late.revision = 1;
+  EXPECT_FALSE(f.Add(late));
   const FusionSessionStats s = f.Stats();
   EXPECT_EQ(s.fused, uint64_t(kViews));
+  EXPECT_EQ(s.revisions_replaced, 1u);
   EXPECT_EQ(s.revisions_ignored, 1u);
   EXPECT_EQ(s.sessions, 1u);
   EXPECT_EQ(s.resets, 0u);
@@ -271,6 +327,7 @@ TEST(FusionSession, FlushFusesWaitingViewsAndOptionsAreChecked) {
   };
   bad([](FusionSessionOptions& o) { o.on_new_session = "forget"; });
   bad([](FusionSessionOptions& o) { o.reorder_timeout = -1; });
+  bad([](FusionSessionOptions& o) { o.revision_timeout = -1; });
   bad([](FusionSessionOptions& o) { o.map_store_mb = 0; });
   bad([](FusionSessionOptions& o) { o.fusion.min_support = 0; });
 }

@@ -186,6 +186,9 @@ struct FusionNodeOptions {
   // Fusion is done in keyframe-id order: a view waits at most this long (s)
   // for a missing earlier keyframe (several workers deliver out of order).
   double reorder_timeout = 2.0;
+  // A view that is not its keyframe's final revision (DepthView) waits at
+  // most this long (s) for it before it is fused as it is; 0 = never waits.
+  double revision_timeout = 30.0;
   // What a new depth-node session (DepthView.session: the depth node reset
   // on a bag loop or pose jump, or was restarted) does to the cloud:
   // "keep" = fuse it into the same cloud (the world frame is the same);

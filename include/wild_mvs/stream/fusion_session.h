@@ -6,8 +6,12 @@
 // they may be fused, in stamp order: the oldest waiting view goes when it
 // is the next keyframe id of the current session, the first (id 0) of a new
 // session, a late view of a session seen before, or when it waited
-// `reorder_timeout`. A second view with a stamp already waiting or fused (a
-// revision) is ignored: the fusion is incremental, the first result stays.
+// `reorder_timeout`; a view that is not its keyframe's final revision
+// (FusionView::final_revision) also waits for that revision, at most
+// `revision_timeout` s after it arrived and only while no view of another
+// session waits (a depth node that reset sends no more revisions). A later revision of a waiting view
+// replaces it; a revision of a view fused already is ignored (counted): the
+// fusion is incremental and never takes a view out again.
 //
 // Sessions (StreamResult::session): the first view of a session not seen
 // before starts it. on_new_session "keep" fuses it into the same cloud;
@@ -45,18 +49,24 @@ struct FusionView {
   uint64_t session_ns = 0;  // StreamResult::session_ns
   uint64_t stamp_ns = 0;    // the view's key
   std::vector<uint64_t> neighbor_stamps_ns;
-  std::chrono::steady_clock::time_point arrived;  // for reorder_timeout
+  int revision = 0;             // StreamResult::revision
+  bool final_revision = true;   // no later revision follows
+  std::chrono::steady_clock::time_point arrived;  // for the timeouts
 };
 
 // The waiting views and the order state (which view comes next).
 class ReorderBuffer {
  public:
   using Clock = std::chrono::steady_clock;
-  explicit ReorderBuffer(double timeout) : timeout_(timeout) {}
+  ReorderBuffer(double timeout, double revision_timeout)
+      : timeout_(timeout), revision_timeout_(revision_timeout) {}
 
   bool Contains(uint64_t stamp_ns) const { return waiting_.count(stamp_ns); }
   // Adds a view (its stamp must not be waiting already).
   void Insert(FusionView view);
+  // Replaces the waiting view of the same stamp when `view` is a later
+  // revision (it keeps the first one's arrival time); false otherwise.
+  bool Replace(FusionView view);
   // Takes the oldest waiting view when it may be fused at `now` (see the
   // file comment). The caller fuses it and reports it with Fused().
   bool PopReady(Clock::time_point now, FusionView* out);
@@ -76,6 +86,7 @@ class ReorderBuffer {
 
  private:
   double timeout_;
+  double revision_timeout_;
   std::map<uint64_t, FusionView> waiting_;  // by stamp (ns)
   int64_t last_fused_id_ = -1;
   int64_t current_session_ = -1;
@@ -85,6 +96,7 @@ class ReorderBuffer {
 struct FusionSessionOptions {
   // The fusion node's parameters of the same names (FusionNodeOptions).
   double reorder_timeout = 2.0;         // s
+  double revision_timeout = 30.0;       // s
   std::string on_new_session = "keep";  // "keep" or "reset"
   std::string output_path;              // stem of the session saves ("" = none)
   double map_store_mb = 256;
@@ -96,7 +108,8 @@ struct FusionSessionOptions {
 struct FusionSessionStats {
   size_t waiting = 0;  // views waiting for their turn
   uint64_t fused = 0;
-  uint64_t revisions_ignored = 0;
+  uint64_t revisions_replaced = 0;  // a waiting view's later revision
+  uint64_t revisions_ignored = 0;   // revisions of views fused already
   uint64_t spilled = 0;  // depth maps written to the spill folder
   uint64_t resets = 0;   // Reset() calls and session resets
   uint64_t sessions = 0;
@@ -120,7 +133,8 @@ class FusionSession {
                 LogCallback on_log = nullptr);
 
   // Adds a decoded view and fuses what is ready. False (counted) when a
-  // view with its stamp is waiting or was fused already.
+  // view with its stamp was fused already, or is waiting with a revision
+  // at least as late.
   bool Add(FusionView view);
   // Fuses the views that waited reorder_timeout (call periodically).
   void FuseReady();
@@ -162,6 +176,7 @@ class FusionSession {
   std::map<uint64_t, int> view_of_stamp_;  // stamp (ns) -> view index
   int next_view_ = 0;
   uint64_t fused_ = 0, revisions_ignored_ = 0, resets_ = 0;
+  uint64_t revisions_replaced_ = 0;
   uint64_t sessions_ = 0, session_saves_ = 0;
   uint64_t cloud_version_ = 0;
   uint64_t newest_stamp_ns_ = 0;  // newest view fused: the cloud's stamp

@@ -9,9 +9,21 @@
 // good neighbours. With select_keyframes = false every frame given is a
 // keyframe (a depth worker fed by a keyframe selector); with reconstruct =
 // false nothing is reconstructed (the selector itself). Reconstructions run on
-// an internal worker pool: AddFrame never waits for them. Each keyframe is
-// reconstructed once. Results are handed to the result callback on a worker
-// thread.
+// an internal worker pool: AddFrame never waits for them. Results are handed
+// to the result callback on a worker thread.
+//
+// Revisions: the offline pipeline's steps, live. Each keyframe is matched
+// once, and that map is delivered at once (revision 0). With the
+// consistency step on (mvs.ablation.consistency, as offline), the keyframe
+// is then revised once: when every neighbour it was matched against is
+// done (matched by this worker, owned by another, failed or evicted; or at
+// the idle flush), its map is checked against those neighbours' maps
+// (FilterByConsistency with mvs.consistency, the offline filter on the same
+// raw maps) and delivered again as revision 1, same stamp. A keyframe
+// without any neighbour map here (all owned by other workers) keeps
+// revision 0. Memory: the depth of every reconstructed keyframe held (4
+// bytes per pixel) and the full first result of the keyframes not yet
+// revised; both go with the keyframe when the store evicts it.
 //
 // Thread-safe: AddFrame / Tick / SetSparsePoints / Reset / Stats may be
 // called from any thread.
@@ -21,6 +33,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -100,7 +113,8 @@ struct StreamResult {
   uint64_t session_ns = 0;
   uint64_t stamp_ns = 0;
   std::string frame_id;
-  int revision = 0;                          // 0 first time, then 1, 2 ...
+  int revision = 0;  // 0 = as matched, 1 = checked against neighbours' maps
+  bool final_revision = true;  // no later revision of this keyframe follows
   std::vector<uint32_t> neighbor_ids;        // keyframe ids matched against
   std::vector<double> neighbor_stamps;       // and their stamps
   std::vector<uint64_t> neighbor_stamps_ns;  // exact (ns)
@@ -115,10 +129,12 @@ struct StreamStats {
   double store_mb = 0;
   uint64_t frames = 0;           // frames given to AddFrame
   uint64_t keyframes_total = 0;  // keyframes created
-  int pending = 0;               // reconstructions queued or running
+  int pending = 0;  // reconstructions queued or running
   int waiting = 0;               // ready keyframes waiting for a free slot
-  uint64_t reconstructed = 0;    // depth maps produced (incl. redone)
-  uint64_t redone = 0;
+  uint64_t reconstructed = 0;    // depth maps matched (revision 0)
+  uint64_t revised = 0;          // revisions delivered (revision 1)
+  int unrevised = 0;  // revision 0 delivered, revision 1 to come (queued,
+                      // running or waiting for the neighbours)
   uint64_t failed = 0;           // reconstructions that threw
   uint64_t evicted_waiting = 0;  // owned keyframes evicted before their
                                  // depth map (store too small for the rate)
@@ -251,8 +267,13 @@ class StreamReconstructor {
   };
   Snapshot MakeSnapshotLocked() const;
   Neighborhood Evaluate(const Snapshot& snap, int index) const;
-  void ScheduleLocked();
+  void ScheduleLocked();  // matching, then revisions
+  void ScheduleMatchingLocked(bool idle);
   void RunReconstruction(uint32_t id, uint64_t generation);
+  // Submits the revisions whose neighbours are done (see the file comment).
+  void ScheduleRevisionsLocked(bool idle);
+  void RunRevision(uint32_t id, uint64_t generation);
+  void ForgetLocked(uint32_t id);  // a keyframe left the store
   void ClearLocked();
 
   StreamOptions options_;
@@ -267,6 +288,11 @@ class StreamReconstructor {
   bool stopping_ = false;
   std::unique_ptr<SparseTracker> tracker_;
   std::set<uint32_t> in_flight_;  // queued or running
+  // Revisions: the depth (and camera) of the matched keyframes held, the
+  // first results waiting for their revision, and revisions in flight.
+  std::map<uint32_t, std::shared_ptr<const DepthMap>> maps_;
+  std::map<uint32_t, StreamResult> unrevised_;
+  std::set<uint32_t> revising_;
   int ready_waiting_ = 0;
   uint32_t next_id_ = 0;
   uint64_t generation_ = 0;
