@@ -229,7 +229,7 @@ class Playback {
   std::string publishers;  // counts of the output publishers
   uint32_t view_publishers = 0;
   std::vector<Received> received;  // every output header seen
-  std::map<uint64_t, wild_mvs::DepthViewConstPtr> views;  // by stamp ns
+  std::map<uint64_t, wild_mvs::DepthViewConstPtr> views;        // by stamp ns
   std::map<uint64_t, wild_mvs::DepthViewConstPtr> first_views;  // revision 0
   std::map<uint64_t, sensor_msgs::ImageConstPtr> depth_images;
   std::map<uint64_t, sensor_msgs::PointCloud2ConstPtr> node_points, xyz_points;
@@ -495,8 +495,8 @@ TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
   ThreadPool pool(2);
   const SyntheticScene& s = p.scene;
   ImageCache images([&s](int v) { return s.images[v]; }, 256);
-  scene.points = ComputeSparseTracks(scene, images, TrackerOptions(), &pool,
-                                     nullptr);
+  scene.points =
+      ComputeSparseTracks(scene, images, TrackerOptions(), &pool, nullptr);
   std::vector<DepthMap> raw(scene.views.size());
   for (size_t v = 0; v < scene.views.size(); ++v)
     raw[v] = ReconstructView(scene, static_cast<int>(v), images, mvs, &pool,

@@ -132,8 +132,7 @@ TEST(SelectorWorkers, EveryKeyframeOnceThoughAWorkerDropsFrames) {
       ASSERT_EQ(views[s].size(), 2u) << "keyframe " << i;
       for (uint32_t rev = 0; rev < 2; ++rev) {
         const wild_mvs::DepthView& v = *views[s][rev];
-        EXPECT_EQ(static_cast<int>(v.worker_index),
-                  KeyframeOwner(s, kWorkers));
+        EXPECT_EQ(static_cast<int>(v.worker_index), KeyframeOwner(s, kWorkers));
         EXPECT_EQ(v.keyframe_id, k->keyframe_id);  // the selector's numbering
         EXPECT_EQ(v.session, k->session);
         EXPECT_EQ(v.revision, rev);

@@ -161,8 +161,8 @@ TEST(StreamReconstructor, RevisionIsTheOfflineConsistencyStep) {
                                           s.depth[v], s.scene.views[v].camera);
     const DepthMetrics m1 = EvaluateDepth(revised.depth, revised.camera,
                                           s.depth[v], s.scene.views[v].camera);
-    EXPECT_GT(m1.completeness, 0.5) << "keyframe " << v << ": "
-                                    << m1.ToString();
+    EXPECT_GT(m1.completeness, 0.5)
+        << "keyframe " << v << ": " << m1.ToString();
     in1_first += m0.relative_accuracy[0] * m0.evaluated;
     in1_last += m1.relative_accuracy[0] * m1.evaluated;
     off5_first += (1 - m0.relative_accuracy[2]) * m0.evaluated;

@@ -9,9 +9,10 @@
 // `reorder_timeout`; a view that is not its keyframe's final revision
 // (FusionView::final_revision) also waits for that revision, at most
 // `revision_timeout` s after it arrived and only while no view of another
-// session waits (a depth node that reset sends no more revisions). A later revision of a waiting view
-// replaces it; a revision of a view fused already is ignored (counted): the
-// fusion is incremental and never takes a view out again.
+// session waits (a depth node that reset sends no more revisions). A later
+// revision of a waiting view replaces it; a revision of a view fused already is
+// ignored (counted): the fusion is incremental and never takes a view out
+// again.
 //
 // Sessions (StreamResult::session): the first view of a session not seen
 // before starts it. on_new_session "keep" fuses it into the same cloud;
@@ -49,8 +50,8 @@ struct FusionView {
   uint64_t session_ns = 0;  // StreamResult::session_ns
   uint64_t stamp_ns = 0;    // the view's key
   std::vector<uint64_t> neighbor_stamps_ns;
-  int revision = 0;             // StreamResult::revision
-  bool final_revision = true;   // no later revision follows
+  int revision = 0;                               // StreamResult::revision
+  bool final_revision = true;                     // no later revision follows
   std::chrono::steady_clock::time_point arrived;  // for the timeouts
 };
 
@@ -110,8 +111,8 @@ struct FusionSessionStats {
   uint64_t fused = 0;
   uint64_t revisions_replaced = 0;  // a waiting view's later revision
   uint64_t revisions_ignored = 0;   // revisions of views fused already
-  uint64_t spilled = 0;  // depth maps written to the spill folder
-  uint64_t resets = 0;   // Reset() calls and session resets
+  uint64_t spilled = 0;             // depth maps written to the spill folder
+  uint64_t resets = 0;              // Reset() calls and session resets
   uint64_t sessions = 0;
   uint64_t session_saves = 0;
   double held_mb = 0;  // depth maps held in memory

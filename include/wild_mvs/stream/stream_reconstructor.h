@@ -129,13 +129,13 @@ struct StreamStats {
   double store_mb = 0;
   uint64_t frames = 0;           // frames given to AddFrame
   uint64_t keyframes_total = 0;  // keyframes created
-  int pending = 0;  // reconstructions queued or running
+  int pending = 0;               // reconstructions queued or running
   int waiting = 0;               // ready keyframes waiting for a free slot
   uint64_t reconstructed = 0;    // depth maps matched (revision 0)
   uint64_t revised = 0;          // revisions delivered (revision 1)
-  int unrevised = 0;  // revision 0 delivered, revision 1 to come (queued,
-                      // running or waiting for the neighbours)
-  uint64_t failed = 0;           // reconstructions that threw
+  int unrevised = 0;    // revision 0 delivered, revision 1 to come (queued,
+                        // running or waiting for the neighbours)
+  uint64_t failed = 0;  // reconstructions that threw
   uint64_t evicted_waiting = 0;  // owned keyframes evicted before their
                                  // depth map (store too small for the rate)
   uint64_t stale_results = 0;    // results discarded after a Reset
