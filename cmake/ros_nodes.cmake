@@ -34,6 +34,11 @@ endforeach()
 add_executable(wild_mvs_write_config src/tools/write_config.cpp)
 target_link_libraries(wild_mvs_write_config PRIVATE wild_mvs_ros wild_mvs_cli)
 target_compile_options(wild_mvs_write_config PRIVATE ${WILD_MVS_WARNINGS})
+# bench/run_live.sh: the depth maps a live run published, as a reconstruct
+# folder for `wild_mvs eval depth` (not installed).
+add_executable(bench_live_depth_maps bench/ros/live_depth_maps.cpp)
+target_link_libraries(bench_live_depth_maps PRIVATE wild_mvs_ros wild_mvs_io)
+target_compile_options(bench_live_depth_maps PRIVATE ${WILD_MVS_WARNINGS})
 if(TARGET wild_mvs_to_bag)
   # `wild_mvs to-bag` finds it beside build/bin/wild_mvs.
   add_custom_command(TARGET wild_mvs_to_bag POST_BUILD

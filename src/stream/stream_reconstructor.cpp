@@ -400,9 +400,11 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
 }
 
 void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
-  if (stopping_) return;
+  // First matches go first (a new keyframe's map is what a robot waits
+  // for); then one revision at a time, so a new keyframe waits for at most
+  // one.
+  if (stopping_ || !in_flight_.empty() || !revising_.empty()) return;
   for (const auto& [id, first] : unrevised_) {
-    if (revising_.count(id)) continue;
     // Every neighbour it was matched against is done (a neighbour no longer
     // held is done too); at the idle flush, with nothing being matched,
     // neighbours that cannot be matched yet are not waited for.
@@ -411,11 +413,12 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
       const KeyframePtr k = store_.Get(n);
       if (k && (!k->done() || in_flight_.count(n))) ready = false;
     }
-    if (!ready && !(idle && in_flight_.empty())) continue;
+    if (!ready && !idle) continue;
     revising_.insert(id);
     const uint64_t gen = generation_;
     const uint32_t rid = id;
     dispatcher_->Submit([this, rid, gen] { RunRevision(rid, gen); });
+    return;
   }
 }
 
@@ -424,36 +427,96 @@ void StreamReconstructor::ForgetLocked(uint32_t id) {
   unrevised_.erase(id);
 }
 
+double StreamReconstructor::MatchKeyframe(const Snapshot& snap, int ref,
+                                          const MvsOptions& mvs,
+                                          StreamResult* result) {
+  const std::vector<KeyframePtr>& kfs = snap.keyframes;
+  ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
+  ViewReport report;
+  result->depth =
+      ReconstructView(snap.scene, ref, cache, mvs, inner_pool_.get(), &report,
+                      cv::Mat(), &snap.points_per_view, &cancel_);
+  result->depth.view = static_cast<int>(kfs[ref]->id);
+  result->depth.neighbors.clear();
+  result->neighbor_ids.clear();
+  result->neighbor_stamps.clear();
+  result->neighbor_stamps_ns.clear();
+  for (int n : report.neighbors) {
+    if (n < 0 || n >= static_cast<int>(kfs.size())) continue;
+    result->neighbor_ids.push_back(kfs[n]->id);
+    result->neighbor_stamps.push_back(kfs[n]->stamp);
+    result->neighbor_stamps_ns.push_back(kfs[n]->stamp_ns);
+    result->depth.neighbors.push_back(static_cast<int>(kfs[n]->id));
+  }
+  double score = 0;
+  for (double s : report.neighbor_scores) score += s;
+  return score;
+}
+
 void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
   StreamResult result;
-  std::vector<std::shared_ptr<const DepthMap>> held;
-  GeometricConsistencyOptions consistency;
+  Snapshot snap;
+  int ref = -1;
+  MvsOptions mvs;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = unrevised_.find(id);
     if (stopping_ || generation != generation_ || it == unrevised_.end()) {
       revising_.erase(id);
+      ScheduleLocked();
       idle_cv_.notify_all();
       return;
     }
     result = it->second;
-    for (uint32_t n : result.neighbor_ids) {
-      auto m = maps_.find(n);
-      if (m != maps_.end()) held.push_back(m->second);
+    if (store_.Get(id)) {
+      snap = MakeSnapshotLocked();
+      for (size_t i = 0; i < snap.keyframes.size(); ++i)
+        if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
     }
-    consistency = options_.mvs.consistency;
+    mvs = options_.mvs;
+    ++stats_.running;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  // The first result's arrays were delivered: the revision works on copies.
-  result.depth.depth = result.depth.depth.clone();
-  result.depth.normal = result.depth.normal.clone();
-  result.depth.confidence = result.depth.confidence.clone();
-  std::vector<const DepthMap*> neighbors;
-  for (const auto& m : held) neighbors.push_back(m.get());
   std::string error;
   try {
+    // 1. Matched again, over every keyframe held: its neighbours on both
+    // sides exist now (the offline view selection). A keyframe the store
+    // no longer holds keeps its first map.
+    if (ref >= 0) {
+      MatchKeyframe(snap, ref, mvs, &result);
+    } else {  // the first result's arrays were delivered: work on copies
+      result.depth.depth = result.depth.depth.clone();
+      result.depth.normal = result.depth.normal.clone();
+      result.depth.confidence = result.depth.confidence.clone();
+    }
+    // 2. The consistency step against the neighbours' latest raw maps; the
+    // new raw map is what later revisions check against.
+    std::vector<std::shared_ptr<const DepthMap>> held;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (uint32_t n : result.neighbor_ids) {
+        auto m = maps_.find(n);
+        if (m != maps_.end()) held.push_back(m->second);
+      }
+      if (ref >= 0 && generation == generation_ && maps_.count(id)) {
+        auto depth_only = std::make_shared<DepthMap>();
+        depth_only->view = result.depth.view;
+        depth_only->camera = result.depth.camera;
+        depth_only->depth = result.depth.depth.clone();
+        maps_[id] = std::move(depth_only);
+      }
+    }
+    std::vector<const DepthMap*> neighbors;
+    for (const auto& m : held) neighbors.push_back(m.get());
     ConsistencyStats stats;
-    FilterByConsistency(&result.depth, neighbors, consistency, &stats);
+    FilterByConsistency(&result.depth, neighbors, mvs.consistency, &stats);
+  } catch (const Cancelled&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --stats_.running;
+    ++stats_.cancelled;
+    revising_.erase(id);
+    idle_cv_.notify_all();
+    return;  // shutting down: nothing to deliver
   } catch (const std::exception& e) {
     error = e.what();
   }
@@ -465,7 +528,7 @@ void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
   bool deliver = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    revising_.erase(id);
+    --stats_.running;
     unrevised_.erase(id);
     if (generation != generation_) {
       ++stats_.stale_results;
@@ -479,7 +542,10 @@ void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
   if (!error.empty() && on_error_)
     on_error_(Msg("keyframe ", id, ": revision failed: ", error));
   if (deliver && on_result_) on_result_(result);
+  // Out of revising_ only now, and the next one scheduled under the same
+  // lock: WaitIdle never sees a gap between two revisions.
   std::lock_guard<std::mutex> lock(mutex_);
+  revising_.erase(id);
   ScheduleLocked();
   idle_cv_.notify_all();
 }
@@ -536,22 +602,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   double score = 0;
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    const std::vector<KeyframePtr>& kfs = snap.keyframes;
-    ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
-    ViewReport report;
-    result.depth =
-        ReconstructView(snap.scene, ref, cache, mvs, inner_pool_.get(), &report,
-                        cv::Mat(), &snap.points_per_view, &cancel_);
-    result.depth.view = static_cast<int>(id);
-    result.depth.neighbors.clear();
-    for (int n : report.neighbors) {
-      if (n < 0 || n >= static_cast<int>(kfs.size())) continue;
-      result.neighbor_ids.push_back(kfs[n]->id);
-      result.neighbor_stamps.push_back(kfs[n]->stamp);
-      result.neighbor_stamps_ns.push_back(kfs[n]->stamp_ns);
-      result.depth.neighbors.push_back(static_cast<int>(kfs[n]->id));
-    }
-    for (double s : report.neighbor_scores) score += s;
+    score = MatchKeyframe(snap, ref, mvs, &result);
   } catch (const Cancelled&) {
     std::lock_guard<std::mutex> lock(mutex_);
     --stats_.running;

@@ -12,18 +12,19 @@
 // an internal worker pool: AddFrame never waits for them. Results are handed
 // to the result callback on a worker thread.
 //
-// Revisions: the offline pipeline's steps, live. Each keyframe is matched
-// once, and that map is delivered at once (revision 0). With the
-// consistency step on (mvs.ablation.consistency, as offline), the keyframe
-// is then revised once: when every neighbour it was matched against is
-// done (matched by this worker, owned by another, failed or evicted; or at
-// the idle flush), its map is checked against those neighbours' maps
-// (FilterByConsistency with mvs.consistency, the offline filter on the same
-// raw maps) and delivered again as revision 1, same stamp. A keyframe
-// without any neighbour map here (all owned by other workers) keeps
-// revision 0. Memory: the depth of every reconstructed keyframe held (4
-// bytes per pixel) and the full first result of the keyframes not yet
-// revised; both go with the keyframe when the store evicts it.
+// Revisions: the offline pipeline's steps, live. A keyframe is matched as
+// soon as it has enough neighbours, mostly earlier ones, and that map is
+// delivered at once (revision 0). With the consistency step on
+// (mvs.ablation.consistency, as offline) it is then revised once, when
+// every neighbour it was matched against is done (matched by this worker,
+// owned by another, failed or evicted; or at the idle flush): matched again
+// over every keyframe held, so with neighbours on both sides as offline,
+// then checked against its neighbours' latest raw maps (FilterByConsistency
+// with mvs.consistency, the offline filter), and delivered as revision 1,
+// same stamp. First matches go first; one revision runs at a time, when no
+// first match is queued or running. Memory: the depth of every matched
+// keyframe held (4 bytes per pixel) and the first result of the keyframes
+// not yet revised; both go with the keyframe when the store evicts it.
 //
 // Thread-safe: AddFrame / Tick / SetSparsePoints / Reset / Stats may be
 // called from any thread.
@@ -273,6 +274,10 @@ class StreamReconstructor {
   // Submits the revisions whose neighbours are done (see the file comment).
   void ScheduleRevisionsLocked(bool idle);
   void RunRevision(uint32_t id, uint64_t generation);
+  // Matches keyframe `ref` of `snap` (ReconstructView over the snapshot):
+  // sets result->depth and its neighbours; returns the neighbour score.
+  double MatchKeyframe(const Snapshot& snap, int ref, const MvsOptions& mvs,
+                       StreamResult* result);
   void ForgetLocked(uint32_t id);  // a keyframe left the store
   void ClearLocked();
 

@@ -1,0 +1,100 @@
+// Copyright wild_mvs authors. The depth maps a live run published, as a
+// reconstruct folder that `wild_mvs eval depth` scores (bench/run_live.sh).
+//
+//   bench_live_depth_maps REC.bag DATASET OUT [--first]
+//
+// Reads every wild_mvs/DepthView of REC.bag (the depth node's depth_view,
+// recorded by reconstruct_bag.launch record:=REC.bag), keeps per keyframe
+// its final revision (--first: its first, revision 0), finds the dataset
+// view it shows (the view whose camera centre is nearest, within 1 mm) and
+// writes OUT/depth/<stem>.pfm with its camera, as `wild_mvs reconstruct`
+// does. Prints the keyframes, views and revisions found. Exit 1 with a
+// message naming the file on bad input.
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <wild_mvs/DepthView.h>
+
+#include <iostream>
+#include <map>
+#include <string>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/io/dataset.h"
+#include "wild_mvs/io/depth_map_io.h"
+#include "wild_mvs/ros/conversions.h"
+
+namespace wild_mvs {
+namespace {
+
+int Run(int argc, char** argv) {
+  if (argc < 4 || argc > 5 ||
+      (argc == 5 && std::string(argv[4]) != "--first")) {
+    std::cerr << "usage: bench_live_depth_maps REC.bag DATASET OUT [--first]\n";
+    return 2;
+  }
+  const std::string bag_path = argv[1], out = argv[3];
+  const bool first = argc == 5;
+  DatasetOptions dataset;
+  dataset.path = argv[2];
+  dataset.check_images = false;
+  const Scene scene = LoadDataset(dataset);
+
+  std::map<uint64_t, wild_mvs::DepthViewConstPtr> by_stamp;
+  int messages = 0, revised = 0;
+  rosbag::Bag bag;
+  try {
+    bag.open(bag_path, rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    throw Error(Msg(bag_path, ": cannot read the bag: ", e.what()));
+  }
+  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+    const wild_mvs::DepthViewConstPtr v = m.instantiate<wild_mvs::DepthView>();
+    if (!v) continue;
+    ++messages;
+    revised += v->revision > 0;
+    const uint64_t key = v->header.stamp.toNSec();
+    auto it = by_stamp.find(key);
+    const bool take =
+        first ? (v->revision == 0 && it == by_stamp.end())
+              : (it == by_stamp.end() || v->revision >= it->second->revision);
+    if (take) by_stamp[key] = v;
+  }
+  Require(messages > 0, bag_path, ": no wild_mvs/DepthView message");
+  int written = 0;
+  for (const auto& [stamp, msg] : by_stamp) {
+    const DepthMap map = ros1::DepthMapFromDepthView(*msg);
+    int best = -1;
+    double best_d = 1e-3;
+    for (size_t i = 0; i < scene.views.size(); ++i) {
+      const double d =
+          (scene.views[i].camera.Center() - map.camera.Center()).norm();
+      if (d < best_d) {
+        best_d = d;
+        best = static_cast<int>(i);
+      }
+    }
+    if (best < 0) {
+      std::cerr << "keyframe " << msg->keyframe_id
+                << ": no dataset view at its camera centre (skipped)\n";
+      continue;
+    }
+    WriteDepthMapFiles(out, scene.views[best].Stem(), map, {}, false);
+    ++written;
+  }
+  std::cout << messages << " depth views (" << revised << " revisions), "
+            << by_stamp.size() << " keyframes, " << written << " of "
+            << scene.views.size() << " views written to " << out << "\n";
+  return 0;
+}
+
+}  // namespace
+}  // namespace wild_mvs
+
+int main(int argc, char** argv) {
+  try {
+    return wild_mvs::Run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "bench_live_depth_maps: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,138 @@
+#!/usr/bin/env bash
+# Live against offline on the same images: a rendered scene with exact
+# ground truth is reconstructed by `wild_mvs reconstruct` and, written as a
+# bag (`wild_mvs to-bag`, one frame per view, --rate views per second),
+# played through the depth and fusion nodes (launch/reconstruct_bag.launch,
+# default parameters, its depth views recorded). Both are scored against the
+# ground truth: the published depth maps (first revisions and final
+# revisions, bench_live_depth_maps) and the offline maps with
+# `wild_mvs eval depth`, the fused clouds with `wild_mvs eval cloud`.
+#
+#   bench/run_live.sh [--families "relief courtyard"] [--seeds 101]
+#                     [--size 640] [--rate 1] [--out DIR] [--skip-build]
+#
+# Needs the ROS build (scripts/common.sh's BUILD_DIR, default build/). Runs
+# its own roscore on a free port. Prints one row per scene and run and
+# writes OUT/live.tsv.
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+OUT="$ROOT/bench/out/live"
+FAMILIES="relief courtyard"
+SEEDS=101
+SIZE=640
+RATE=1
+BUILD=missing
+usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --families) FAMILIES="$2"; shift 2 ;;
+    --seeds) SEEDS="$2"; shift 2 ;;
+    --size) SIZE="$2"; shift 2 ;;
+    --rate) RATE="$2"; shift 2 ;;
+    --out) OUT="$2"; shift 2 ;;
+    --skip-build) BUILD=never; shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "run_live.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
+  esac
+done
+source "$ROOT/scripts/common.sh"
+DEVEL="$BUILD_DIR/../devel"
+[ -d "$DEVEL" ] || DEVEL="$ROOT/devel"
+if [ "$BUILD" = missing ]; then
+  wild_mvs_build >&2
+  cmake --build "$BUILD_DIR" -j"$JOBS" --target bench_live_depth_maps >&2
+fi
+BIN="$DEVEL/lib/wild_mvs"
+for b in wild_mvs make_scene wild_mvs_to_bag bench_live_depth_maps; do
+  [ -x "$BIN/$b" ] || { echo "run_live.sh: $BIN/$b missing (drop --skip-build)" >&2; exit 1; }
+done
+set +u
+source "$DEVEL/setup.bash"
+set -u
+PORT=$((20000 + RANDOM % 20000))
+export ROS_MASTER_URI="http://localhost:$PORT"
+export ROS_HOME="$OUT/ros_home"
+mkdir -p "$OUT" "$ROS_HOME"
+
+noise_of() { case "$1" in relief|weak) echo 0.01 ;; *) echo "" ;; esac; }
+kinds_of() {
+  case "$1" in
+    courtyard) echo light ;;
+    relief|weak) echo "$1" ;;
+    *) echo "$1" ;;
+  esac
+}
+
+score() {  # RUN_DIR SCENE_DIR -> "coverage in1 off5"
+  "$BIN/wild_mvs" eval depth --est "$1" --gt-dir "$2/gt_depth" \
+    --rel-thresholds 0.01,0.05 --json "$1/eval_depth.json" >/dev/null
+  /usr/bin/python3 - "$1/eval_depth.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+a = d["relative_accuracy"]
+print("%.3f %.3f %.2f%%" % (d["completeness"], a[0], 100 * (1 - a[1])))
+PY
+}
+fscore() {  # CLOUD SCENE_DIR -> "F@1cm F@5cm"
+  "$BIN/wild_mvs" eval cloud "$1" "$2/gt_surface.ply" --tau 0.01,0.05 \
+    --json "$1.eval.json" >/dev/null
+  /usr/bin/python3 -c "import json,sys; c=json.load(open(sys.argv[1])); print(' '.join('%.3f' % f for f in c['fscore']))" "$1.eval.json"
+}
+
+TSV="$OUT/live.tsv"
+printf 'scene\tseed\trun\tviews\tcoverage\tin1%%\toff>5%%\tF@1cm\tF@5cm\tcpu_s\n' >"$TSV"
+for family in $FAMILIES; do
+  for seed in ${SEEDS//,/ }; do
+    kind=$(kinds_of "$family")
+    noise=$(noise_of "$family")
+    scene="$OUT/scenes/${kind}_s${seed}_$SIZE"
+    if [ ! -f "$scene/gt_surface.ply" ]; then
+      rm -rf "$scene"
+      "$BIN/make_scene" "$kind" "$scene" --seed "$seed" --width "$SIZE" \
+        --height $((SIZE * 3 / 4)) ${noise:+--noise "$noise"} >&2
+    fi
+    nviews=$(ls "$scene/gt_depth" | wc -l)
+    run="$OUT/${kind}_s$seed"
+    rm -rf "$run"
+    mkdir -p "$run"
+    # Offline.
+    /usr/bin/time -f '%U %S' -o "$run/offline.time" \
+      "$BIN/wild_mvs" reconstruct "$scene" "$run/offline" --threads 2 \
+      >"$run/offline.log" 2>&1
+    read -r u s <"$run/offline.time"
+    off=$(score "$run/offline" "$scene")
+    f=$(fscore "$run/offline/fused.ply" "$scene")
+    n=$(ls "$run/offline/depth" | grep -c '\.pfm$')
+    printf '%s\t%s\toffline\t%s/%s\t%s\t%s\t%.1f\n' "$kind" "$seed" "$n" "$nviews" \
+      "${off// /	}" "${f// /	}" "$(echo "$u + $s" | bc)" >>"$TSV"
+    # Live.
+    "$BIN/wild_mvs_to_bag" "$scene" "$run/scene.bag" --rate "$RATE" >"$run/bag.log" 2>&1
+    roscore -p "$PORT" >"$run/roscore.log" 2>&1 &
+    core=$!
+    sleep 3
+    /usr/bin/time -f '%U %S' -o "$run/live.time" \
+      roslaunch wild_mvs reconstruct_bag.launch bag:="$run/scene.bag" \
+      output:="$run/live_fused.ply" record:="$run/live.bag" >"$run/live.log" 2>&1 || true
+    kill "$core" 2>/dev/null || true
+    wait "$core" 2>/dev/null || true
+    read -r u s <"$run/live.time"
+    cpu=$(echo "$u + $s" | bc)
+    for which in first final; do
+      flag=()
+      [ "$which" = first ] && flag=(--first)
+      "$BIN/bench_live_depth_maps" "$run/live.bag" "$scene" "$run/live_$which" \
+        ${flag[@]+"${flag[@]}"} >"$run/live_$which.log" 2>&1
+      n=$(ls "$run/live_$which/depth" 2>/dev/null | grep -c '\.pfm$' || true)
+      sc=$(score "$run/live_$which" "$scene")
+      if [ "$which" = final ] && [ -f "$run/live_fused.ply" ]; then
+        f=$(fscore "$run/live_fused.ply" "$scene")
+      else
+        f="- -"
+      fi
+      printf '%s\t%s\tlive %s revisions\t%s/%s\t%s\t%s\t%s\n' "$kind" "$seed" \
+        "$which" "$n" "$nviews" "${sc// /	}" "${f// /	}" \
+        "$([ "$which" = final ] && echo "$cpu" || echo -)" >>"$TSV"
+    done
+  done
+done
+column -t -s $'\t' "$TSV"
