@@ -164,7 +164,8 @@ struct FusionNode::Impl {
 
   bool OnSave(wild_mvs::SaveCloud::Request& req,
               wild_mvs::SaveCloud::Response& res) {
-    const std::string path = req.path.empty() ? options.output_path : req.path;
+    const std::string path =
+        req.path.empty() ? options.session.output_path : req.path;
     if (path.empty()) {
       res.success = false;
       res.message = "no path given and ~output_path is not set";
@@ -237,7 +238,7 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.drops.set_window(m.options.drop_window);
   const FusionNodeOptions& o = m.options;
   m.session = std::make_unique<FusionSession>(
-      SessionOptions(o),
+      o.session,
       [&m](const std::string& problem, const std::string& detail) {
         m.Drop(problem, detail);
       },
@@ -295,13 +296,14 @@ FusionNode::~FusionNode() {
     } catch (const std::exception&) {
     }
   }
-  if (!m.options.output_path.empty()) {
+  if (!m.options.session.output_path.empty()) {
     try {
-      const size_t n = m.Save(m.options.output_path);
+      const size_t n = m.Save(m.options.session.output_path);
       ROS_INFO("%s: saved %zu points to %s on shutdown",
-               m.pnh.getNamespace().c_str(), n, m.options.output_path.c_str());
+               m.pnh.getNamespace().c_str(), n,
+               m.options.session.output_path.c_str());
       std::fprintf(stderr, "fusion node: saved %zu points to %s\n", n,
-                   m.options.output_path.c_str());
+                   m.options.session.output_path.c_str());
     } catch (const std::exception& e) {
       ROS_ERROR("%s: saving on shutdown failed: %s",
                 m.pnh.getNamespace().c_str(), e.what());
