@@ -197,6 +197,15 @@ std::string DepthInputs::ImageTopic(const DepthFrame& f) const {
   return image_topic_ + (f.raw ? "" : "/" + options_.image_transport);
 }
 
+std::string DepthInputs::Describe() const {
+  const DepthNodeOptions& o = options_;
+  return Msg("images ", image_topic_, " (", o.image_transport,
+             rectified_ ? ", rectified" : "", "), camera_info ", info_topic_,
+             " (", o.camera_info_latest ? "latest" : "paired by stamp",
+             "), pose from ", o.pose_source, ", sparse points from ",
+             o.sparse_source, ", world frame '", o.world_frame, "'");
+}
+
 std::string DepthInputs::NoSlash(const std::string& frame_id) {
   const std::string stripped = StripLeadingSlash(frame_id);
   if (stripped == frame_id) return frame_id;

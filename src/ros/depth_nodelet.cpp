@@ -6,7 +6,6 @@
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
 
-#include <atomic>
 #include <cstdio>
 #include <limits>
 #include <pluginlib/class_list_macros.hpp>
@@ -14,13 +13,16 @@
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/ros/bus_stats.h"
 #include "wild_mvs/ros/conversions.h"
+#include "wild_mvs/ros/depth_front_end.h"
 #include "wild_mvs/ros/depth_inputs.h"
 #include "wild_mvs/ros/depth_messages.h"
+#include "wild_mvs/ros/depth_worker_input.h"
 #include "wild_mvs/ros/keyframe_link.h"
 #include "wild_mvs/ros/live_params.h"
 #include "wild_mvs/ros/params_ros.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
+#include "wild_mvs/stream/stream_reports.h"
 #include "wild_mvs/stream/work_queue.h"
 
 namespace wild_mvs {
@@ -44,44 +46,15 @@ struct DepthNode::Impl {
   // of the updater, which is destroyed first).
   std::unique_ptr<RateStatus> frame_rate, map_rate;
   std::unique_ptr<diagnostic_updater::Updater> updater;
-  // Live tuning (dynamic_reconfigure protocol) over a copy of the options,
-  // and ~reset.
-  DepthNodeOptions live;
-  OptionRegistry live_registry;
-  std::unique_ptr<LiveParams> live_params;
+  // Live tuning (dynamic_reconfigure protocol) and ~reset.
+  std::unique_ptr<DepthLiveParams> live_params;
   ros::ServiceServer reset_srv;
-  std::atomic<uint64_t> evictions_reported{0};
-  DropCounter evictions;         // throttles the warning below
   RoscppDropWatch roscpp_drops;  // roscpp's own queue drops, into `drops`
-  // Several workers: the selector's announcer, a worker's receiver.
+  // The roles (~role): a selector's announcer, a worker's keyframe input.
   std::unique_ptr<KeyframeAnnouncer> announcer;
-  std::unique_ptr<KeyframeReceiver> receiver;
-  ros::Subscriber keyframe_sub, index_sub;
+  std::unique_ptr<DepthWorkerInput> worker;
   ros::SteadyTimer index_timer;
-
-  // Warns (throttled) when keyframes were evicted from the full keyframe
-  // store before their depth map was made: reconstruction is slower than
-  // keyframes arrive. They are counted in diagnostics and in the summary.
-  // `total`: StreamStats::evicted_waiting.
-  void ReportEvictions(uint64_t total) {
-    uint64_t seen = evictions_reported.load();
-    while (seen < total &&
-           !evictions_reported.compare_exchange_weak(seen, total)) {
-    }
-    if (seen >= total) return;
-    bool log = false;
-    for (uint64_t k = seen; k < total; ++k) log |= evictions.Count("evicted");
-    if (log)
-      ROS_WARN(
-          "%s: keyframe store full: %lu keyframes so far evicted before "
-          "their depth map (depth maps are made slower than keyframes "
-          "arrive; max_keyframes = %d, max_keyframe_mb = %.0f: raise them, "
-          "lower the frame rate or keyframe_min_baseline; throttled to one "
-          "message per %.0f s)",
-          pnh.getNamespace().c_str(), static_cast<unsigned long>(total),
-          options.stream.store.max_keyframes, options.stream.store.max_mb,
-          kErrorThrottle);
-  }
+  std::unique_ptr<DepthFrontEnd> front_end;  // the queue's thread
 
   // Counts and (throttled) reports one dropped input.
   void Drop(const std::string& topic, const std::string& problem,
@@ -101,7 +74,7 @@ struct DepthNode::Impl {
   // The topic frames come from: `image` (or its compressed topic), a
   // worker's `keyframes`.
   std::string InputTopic() const {
-    if (receiver) return receiver->keyframes_topic();
+    if (worker) return worker->keyframes_topic();
     return inputs->Topic("image") +
            (options.image_transport == "raw" ? "" : "/compressed");
   }
@@ -113,105 +86,12 @@ struct DepthNode::Impl {
            "input queue full (frames arrive faster than they are processed)");
   }
 
-  // Adds a frame whose camera (intrinsics and pose) is known to the stream;
-  // only a keyframe's image is converted.
-  StreamReconstructor::FrameStatus AddToStream(const DepthFrame& f,
-                                               const Camera& cam,
-                                               const std::string& topic) {
-    StreamReconstructor::FrameStatus status;
-    try {
-      status = stream->AddFrame(f.stamp.toNSec(), f.frame_id, cam,
-                                [this, &f](Camera* c, cv::Mat* image) {
-                                  return inputs->ConvertImage(f, c, image);
-                                });
-    } catch (const Error& e) {
-      Drop(topic, "rejected frame", e.what());
-      return StreamReconstructor::FrameStatus::kDropped;
-    }
-    ReportEvictions(stream->Stats().evicted_waiting);
-    switch (status) {
-      case StreamReconstructor::FrameStatus::kOutOfOrder:
-        Drop(topic, "stamp out of order (not after the previous frame)");
-        break;
-      case StreamReconstructor::FrameStatus::kReset:
-        ROS_WARN(
-            "%s: time or pose jump at stamp %.3f: keyframes and tracks "
-            "reset, starting again from this frame",
-            pnh.getNamespace().c_str(), f.stamp.toSec());
-        break;
-      default:
-        break;
-    }
-    return status;
-  }
-
-  // A worker: one keyframe of the selector (in id order, KeyframeReceiver).
-  void TakeKeyframe(const wild_mvs::SelectedKeyframeConstPtr& k) {
-    const std::string topic = receiver->keyframes_topic();
-    if (inputs->NoSlash(k->camera_pose.header.frame_id) !=
-        options.world_frame) {
-      Drop(topic, "camera_pose frame is not the world frame",
-           "'" + k->camera_pose.header.frame_id + "' vs '" +
-               options.world_frame + "'");
-      return;
-    }
-    DepthFrame f;
-    f.stamp = k->header.stamp;
-    f.frame_id = inputs->NoSlash(k->header.frame_id);
-    // The selector's messages, shared (no copy of the pixels).
-    if (!k->image.data.empty())
-      f.raw = sensor_msgs::ImageConstPtr(k, &k->image);
-    else if (!k->compressed.data.empty())
-      f.compressed = sensor_msgs::CompressedImageConstPtr(k, &k->compressed);
-    if (!f.raw && !f.compressed) {
-      Drop(topic, "keyframe without an image");
-      return;
-    }
-    f.info = sensor_msgs::CameraInfoConstPtr(k, &k->camera_info);
-    Camera cam;
-    if (!inputs->CameraFromInfo(f, &cam)) return;
-    try {
-      SetCameraPose(k->camera_pose.pose, &cam);
-    } catch (const Error& e) {
-      Drop(topic, "invalid camera_pose", e.what());
-      return;
-    }
-    // The selector's session, numbering and tracks.
-    stream->FollowSession(k->session.toNSec());
-    stream->SetNextKeyframeId(k->keyframe_id);
-    stream->SetSparsePoints(StampedPointsFromMsg(k->points));
-    AddToStream(f, cam, topic);
-  }
-
-  // The front end, one frame at a time.
-  void Process(DepthFrame f) {
-    if (f.keyframe) return receiver->OnKeyframe(f.keyframe);
-    if (f.index) return receiver->OnIndex(f.index);
-    const std::string image_topic = inputs->ImageTopic(f);
-    if (!inputs->PairCameraInfo(&f)) return;
-    if (stream->IsOutOfOrder(f.stamp.toNSec())) {
-      Drop(image_topic, "stamp out of order (not after the previous frame)");
-      return;
-    }
-    // Intrinsics and pose first: the keyframe test needs only the pose, and
-    // only a keyframe's image is decoded and undistorted.
-    Camera cam;
-    if (!inputs->CameraFromInfo(f, &cam) || !inputs->LookupPose(f, &cam))
-      return;
-    const StreamReconstructor::FrameStatus status =
-        AddToStream(f, cam, image_topic);
-    // A selector hands each new keyframe to the workers.
-    if (announcer && (status == StreamReconstructor::FrameStatus::kKeyframe ||
-                      status == StreamReconstructor::FrameStatus::kReset)) {
-      StreamReconstructor::KeyframeInfo info;
-      if (stream->Newest(&info) && info.stamp_ns == f.stamp.toNSec())
-        announcer->Publish(info, f, cam, stream->TrackedPoints());
-    }
-  }
-
   void FrontEnd(DepthFrame f) {
     try {
-      Process(std::move(f));
+      if (worker)
+        worker->Process(f);
+      else
+        front_end->ProcessImage(std::move(f));
     } catch (const std::exception& e) {
       Drop(InputTopic(), "unexpected error", e.what());
     }
@@ -227,8 +107,9 @@ struct DepthNode::Impl {
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     std::map<std::string, std::string> queues = inputs->QueueParams();
-    if (keyframe_sub)
-      queues[keyframe_sub.getTopic()] = "the worker falls behind the keyframes";
+    if (worker)
+      queues[worker->subscribed_topic()] =
+          "the worker falls behind the keyframes";
     roscpp_drops.Update(queues, &drops);
     const StreamStats s = stream->Stats();
     DepthInputStats in;
@@ -237,19 +118,12 @@ struct DepthNode::Impl {
       in.keyframes_published = announcer->published();
       in.keyframes_served = announcer->served();
     }
-    if (receiver) {
-      const KeyframeReceiver::Stats r = receiver->stats();
-      in.keyframes_received = r.received;
-      in.keyframes_fetched = r.fetched;
-      in.keyframes_lost = r.lost;
-      in.keyframes_repeated = r.repeated;
-    }
-    // A worker's queue also carries the index messages: count keyframes.
-    in.received = receiver ? receiver->stats().received : queue->received();
+    in.received = queue->received();
+    if (worker) worker->AddStats(&in);  // keyframes, not queued messages
     in.queued = queue->size();
     in.queue_size = static_cast<int>(queue->capacity());
-    ReportEvictions(s.evicted_waiting);
-    in.recent_evictions = evictions.RecentTotal();
+    front_end->ReportEvictions(s.evicted_waiting);
+    in.recent_evictions = front_end->recent_evictions();
     FillDepthDiagnostics(s, in, drops, stat);
   }
 };
@@ -259,23 +133,18 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   Impl& m = *impl_;
   m.nh = nh;
   m.pnh = pnh;
-  RosParamSource params(pnh);
-  m.options = ReadDepthNodeOptions(params);
-  for (const std::string& n : UnknownDepthNodeParams(params))
-    ROS_WARN("%s: unknown parameter '%s' (ignored; see config/depth_node.yaml)",
-             pnh.getNamespace().c_str(), n.c_str());
-  m.inputs = std::make_unique<DepthInputs>(
-      m.nh, m.pnh, m.options,
-      [&m](const std::string& topic, const std::string& problem,
-           const std::string& detail) { m.Drop(topic, problem, detail); });
+  m.options = LoadDepthNodeOptions(pnh);
+  auto drop = [&m](const std::string& topic, const std::string& problem,
+                   const std::string& detail) {
+    m.Drop(topic, problem, detail);
+  };
+  m.inputs = std::make_unique<DepthInputs>(m.nh, m.pnh, m.options, drop);
   // Frame ids as tf2 wants them (leading '/' stripped, warned once).
   m.options.world_frame = m.inputs->NoSlash(m.options.world_frame);
   if (!m.options.camera_frame.empty())
     m.options.camera_frame = m.inputs->NoSlash(m.options.camera_frame);
   m.drops.set_throttle(kErrorThrottle);
-  m.evictions.set_throttle(kErrorThrottle);
   m.drops.set_window(kDropWindow);
-  m.evictions.set_window(kDropWindow);
   const DepthNodeOptions& o = m.options;
 
   // Created before any callback or worker can tick them.
@@ -302,43 +171,28 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.queue = std::make_unique<WorkQueue<DepthFrame>>(
       o.role == "worker" ? kKeyframeQueueSize : o.input_queue_size,
       [&m](DepthFrame f) { m.FrontEnd(std::move(f)); });
+  if (o.role == "selector") {
+    m.announcer = std::make_unique<KeyframeAnnouncer>(m.pnh, o.world_frame,
+                                                      kKeyframeHistory);
+    m.index_timer = m.nh.createSteadyTimer(
+        ros::WallDuration(1.0),
+        [&m](const ros::SteadyTimerEvent&) { m.announcer->PublishIndex(); });
+  }
+  m.front_end = std::make_unique<DepthFrontEnd>(pnh.getNamespace(), m.options,
+                                                m.inputs.get(), m.stream.get(),
+                                                m.announcer.get(), drop);
+  auto enqueue = [&m](DepthFrame f) { m.Enqueue(std::move(f)); };
   if (o.role == "worker") {
-    m.receiver = std::make_unique<KeyframeReceiver>(
-        m.nh, kRepairDelay,
-        [&m](const wild_mvs::SelectedKeyframeConstPtr& k) {
-          m.TakeKeyframe(k);
-        },
-        [&m](const std::string& topic, const std::string& problem,
-             const std::string& detail) { m.Drop(topic, problem, detail); });
-    m.keyframe_sub = m.nh.subscribe<wild_mvs::SelectedKeyframe>(
-        "keyframes", kKeyframeQueueSize,
-        [&m](const wild_mvs::SelectedKeyframeConstPtr& k) {
-          DepthFrame f;
-          f.keyframe = k;
-          f.stamp = k->header.stamp;
-          m.Enqueue(std::move(f));
-        });
-    m.index_sub = m.nh.subscribe<wild_mvs::KeyframeIndex>(
-        "keyframe_index", 10, [&m](const wild_mvs::KeyframeIndexConstPtr& k) {
-          DepthFrame f;
-          f.index = k;
-          m.Enqueue(std::move(f));
-        });
+    m.worker = std::make_unique<DepthWorkerInput>(
+        m.nh, m.options, m.inputs.get(), drop,
+        [&m](const WorkerKeyframe& k) { m.front_end->TakeKeyframe(k); });
+    m.worker->Subscribe(enqueue);
   } else {
-    if (o.role == "selector") {
-      m.announcer = std::make_unique<KeyframeAnnouncer>(m.pnh, o.world_frame,
-                                                        kKeyframeHistory);
-      m.index_timer = m.nh.createSteadyTimer(
-          ros::WallDuration(1.0),
-          [&m](const ros::SteadyTimerEvent&) { m.announcer->PublishIndex(); });
-    }
     m.inputs->Subscribe(
-        [&m](DepthFrame f) { m.Enqueue(std::move(f)); },
-        [&m](std::vector<StreamReconstructor::StampedPoint> points) {
+        enqueue, [&m](std::vector<StreamReconstructor::StampedPoint> points) {
           m.stream->SetSparsePoints(points);
         });
   }
-
   m.updater = std::make_unique<diagnostic_updater::Updater>(
       m.nh, m.pnh, m.pnh.getNamespace());
   m.updater->setHardwareID("wild_mvs_depth");
@@ -351,43 +205,17 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.tick_timer = m.nh.createSteadyTimer(
       ros::WallDuration(0.2),
       [&m](const ros::SteadyTimerEvent&) { m.stream->Tick(); });
-  // Live: the keyframe thresholds and the main MVS thresholds.
-  m.live = m.options;
-  RegisterOptions(&m.live_registry, "", &m.live);
-  m.live_params = std::make_unique<LiveParams>(
-      m.pnh, &m.live_registry,
-      std::vector<std::string>{
-          "keyframe_min_baseline", "keyframe_min_angle_deg",
-          "mvs.max_image_size", "mvs.global.num_neighbors", "mvs.local.min_ncc",
-          "mvs.mpgc.drop_ncc", "mvs.growing.revisit_margin"},
-      [&m] {
-        m.live.Check();
-        m.stream->SetOptions(m.live.stream);
-      });
+  m.live_params = std::make_unique<DepthLiveParams>(
+      m.pnh, m.options,
+      [&m](const StreamOptions& live) { m.stream->SetOptions(live); });
   m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
   m.queue->Start();  // the front-end thread
-  if (o.role == "worker") {
-    ROS_INFO(
-        "%s: depth worker %d of %d, keyframes from %s (missed ones from %s), "
-        "world frame '%s'",
-        pnh.getNamespace().c_str(), o.stream.worker_index,
-        o.stream.worker_count, m.receiver->keyframes_topic().c_str(),
-        m.nh.resolveName("get_keyframe").c_str(), o.world_frame.c_str());
-  } else {
-    const std::string what = o.role == "selector"
-                                 ? std::string("keyframe selector (~keyframes)")
-                                 : Msg("worker ", o.stream.worker_index, " of ",
-                                       o.stream.worker_count);
-    ROS_INFO(
-        "%s: %s, images %s (%s%s), camera_info %s (%s), pose from %s, sparse "
-        "points from %s, world frame '%s'",
-        pnh.getNamespace().c_str(), what.c_str(),
-        m.inputs->image_topic().c_str(), o.image_transport.c_str(),
-        m.inputs->rectified() ? ", rectified" : "",
-        m.inputs->info_topic().c_str(),
-        o.camera_info_latest ? "latest" : "paired by stamp",
-        o.pose_source.c_str(), o.sparse_source.c_str(), o.world_frame.c_str());
-  }
+  std::string what = o.role == "selector"
+                         ? "keyframe selector (~keyframes)"
+                         : Msg("worker ", o.stream.worker_index, " of ",
+                               o.stream.worker_count);
+  what = m.worker ? m.worker->Describe() : what + ", " + m.inputs->Describe();
+  ROS_INFO("%s: %s", pnh.getNamespace().c_str(), what.c_str());
 }
 
 DepthNode::~DepthNode() {
@@ -395,25 +223,15 @@ DepthNode::~DepthNode() {
   m.tick_timer.stop();
   m.diag_timer.stop();
   m.index_timer.stop();
-  m.keyframe_sub.shutdown();
-  m.index_sub.shutdown();
+  if (m.worker) m.worker->Stop();
   m.inputs->Stop();  // ends the waits, unsubscribes the images
   m.queue->Stop();   // joins the front end; frames still queued are dropped
   // A running depth map is cancelled (it ends within a few pixels per
   // tile: roslaunch escalates to SIGKILL 15 s after SIGINT).
   m.stream->Shutdown();
   const StreamStats s = m.stream->Stats();
-  std::fprintf(stderr,
-               "depth node: %lu frames received, %lu keyframes, %lu depth "
-               "maps (%lu cancelled at shutdown), %lu frames dropped, %lu "
-               "keyframes evicted before a depth map, %lu stream resets\n",
-               static_cast<unsigned long>(m.queue->received()),
-               static_cast<unsigned long>(s.keyframes_total),
-               static_cast<unsigned long>(s.reconstructed),
-               static_cast<unsigned long>(s.cancelled),
-               static_cast<unsigned long>(m.drops.Total()),
-               static_cast<unsigned long>(s.evicted_waiting),
-               static_cast<unsigned long>(s.resets));
+  std::fprintf(stderr, "depth node: %s\n",
+               StreamSummary(m.queue->received(), m.drops.Total(), s).c_str());
   m.stream.reset();
 }
 

@@ -28,18 +28,6 @@ FusionView FusionViewFromMsg(const wild_mvs::DepthView& msg) {
   return view;
 }
 
-FusionSessionOptions SessionOptions(const FusionNodeOptions& o) {
-  FusionSessionOptions so;
-  so.reorder_timeout = o.reorder_timeout;
-  so.revision_timeout = o.revision_timeout;
-  so.on_new_session = o.on_new_session;
-  so.output_path = o.output_path;
-  so.map_store_mb = o.map_store_mb;
-  so.spill_dir = o.spill_dir;
-  so.fusion = o.fusion;
-  return so;
-}
-
 void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
                            size_t queued, const DropCounter& drops,
                            diagnostic_updater::DiagnosticStatusWrapper& stat) {

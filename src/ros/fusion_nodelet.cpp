@@ -4,9 +4,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
-#include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Trigger.h>
-#include <visualization_msgs/Marker.h>
 #include <wild_mvs/DepthView.h>
 #include <wild_mvs/KeyframeIndex.h>
 #include <wild_mvs/SaveCloud.h>
@@ -20,17 +18,12 @@
 #include "wild_mvs/ros/conversions.h"
 #include "wild_mvs/ros/diagnostics.h"
 #include "wild_mvs/ros/fusion_messages.h"
+#include "wild_mvs/ros/fusion_outputs.h"
 #include "wild_mvs/ros/params_ros.h"
-#include "wild_mvs/stream/cloud_file.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/fusion_session.h"
 #include "wild_mvs/stream/keyframe_ledger.h"
-#include "wild_mvs/stream/periodic_worker.h"
 #include "wild_mvs/stream/work_queue.h"
-#if __has_include("wild_mvs/core/meshing.h")
-#include "wild_mvs/core/meshing.h"
-#define WILD_MVS_HAVE_MESHING 1
-#endif
 
 namespace wild_mvs {
 namespace ros1 {
@@ -41,28 +34,24 @@ struct FusionNode::Impl {
   DropCounter drops;
   RoscppDropWatch roscpp_drops;  // roscpp's own queue drops, into `drops`
   ros::Subscriber sub;
-  ros::Publisher cloud_pub, mesh_pub;
   ros::ServiceServer save_srv, reset_srv;
-  // Periodic work about machine time: steady timers, so that the cloud is
-  // still published when /clock pauses or stops (sim time, bag ended).
+  // Periodic work about machine time: steady timers, so that diagnostics
+  // go on when /clock pauses or stops (sim time, bag ended).
   ros::SteadyTimer diag_timer;
-  // Slow work off the callback threads: publishing (with the views that
-  // waited reorder_timeout fused first), saves and resets on one worker,
-  // meshing on another. Callbacks only queue and wait.
-  PeriodicWorker output_worker, mesh_worker;
   // Rate of depth views received (a task of the updater, destroyed first).
   std::unique_ptr<RateStatus> view_rate;
   std::unique_ptr<diagnostic_updater::Updater> updater;
   // Reorder buffer, session policy, spill store and the fusion itself.
   std::unique_ptr<FusionSession> session;
+  // ~cloud, ~mesh, saves and resets, on their own threads (destroyed
+  // before the session).
+  std::unique_ptr<FusionOutputs> outputs;
   // Input queue (callback -> its fusion thread).
   std::unique_ptr<WorkQueue<wild_mvs::DepthViewConstPtr>> queue;
   // Keyframes a selector announced (`keyframe_index`) and the depth views
   // received for them: names missing and twice-done keyframes.
   std::unique_ptr<KeyframeLedger> ledger;
   ros::Subscriber index_sub;
-  // Cloud versions sent (only touched inside FusionSession::CloudIfChanged).
-  uint64_t published_version = 0, meshed_version = 0;
 
   std::string Topic() const { return nh.resolveName("depth_view"); }
 
@@ -119,63 +108,17 @@ struct FusionNode::Impl {
     }
   }
 
-  void PublishCloud(bool force) {
-    session->FuseReady();  // views that waited reorder_timeout
-    PointCloud cloud;
-    uint64_t stamp = 0;
-    if (!session->CloudIfChanged(&published_version, force, &cloud, &stamp))
-      return;
-    sensor_msgs::PointCloud2 msg =
-        CloudToMsg(cloud, static_cast<size_t>(options.max_published_points));
-    msg.header.stamp.fromNSec(stamp);
-    msg.header.frame_id = options.world_frame;
-    cloud_pub.publish(msg);
-  }
-
-  void PublishMesh() {
-#ifdef WILD_MVS_HAVE_MESHING
-    PointCloud cloud;
-    uint64_t stamp = 0;
-    if (!session->CloudIfChanged(&meshed_version, false, &cloud, &stamp))
-      return;
-    if (cloud.size() < 100 || !cloud.has_normal()) return;
-    try {
-      MeshingOptions mo;
-      mo.depth = 8;
-      Mesh mesh = MeshPointCloud(cloud, mo);
-      visualization_msgs::Marker m = MeshToMarker(mesh);
-      m.header.stamp.fromNSec(stamp);
-      m.header.frame_id = options.world_frame;
-      m.ns = "wild_mvs";
-      mesh_pub.publish(m);
-    } catch (const std::exception& e) {
-      ROS_WARN_THROTTLE(30, "%s: meshing failed: %s",
-                        pnh.getNamespace().c_str(), e.what());
-    }
-#endif
-  }
-
-  size_t Save(const std::string& path) {
-    // Views still waiting for an earlier keyframe are fused first.
-    const PointCloud cloud = session->FlushAndCloud();
-    SaveCloudPly(path, cloud);
-    return cloud.size();
-  }
-
   bool OnSave(wild_mvs::SaveCloud::Request& req,
               wild_mvs::SaveCloud::Response& res) {
-    const std::string path = req.path.empty() ? options.output_path : req.path;
+    const std::string& path =
+        req.path.empty() ? options.session.output_path : req.path;
     if (path.empty()) {
       res.success = false;
       res.message = "no path given and ~output_path is not set";
       return true;
     }
     try {
-      // On the output worker (the disk I/O never runs on a callback thread);
-      // this callback thread only waits for it.
-      size_t n = 0;
-      output_worker.Post([&] { n = Save(path); }).get();
-      res.num_points = n;
+      res.num_points = outputs->SaveOnWorker(path);
       res.success = true;
       res.message = path;
       ROS_INFO("%s: saved %lu points to %s", pnh.getNamespace().c_str(),
@@ -189,12 +132,7 @@ struct FusionNode::Impl {
   }
 
   bool OnReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-    output_worker
-        .Post([this] {
-          session->Reset();
-          PublishCloud(true);
-        })
-        .get();
+    outputs->ResetOnWorker();
     res.success = true;
     res.message = "fused cloud cleared";
     return true;
@@ -212,6 +150,13 @@ struct FusionNode::Impl {
     for (const ros::Time& t : msg->stamps)
       ledger->Announce(msg->session.toNSec(), t.toNSec());
   }
+
+  void Log(bool error, const std::string& message) {
+    if (error)
+      ROS_ERROR("%s: %s", pnh.getNamespace().c_str(), message.c_str());
+    else
+      ROS_INFO("%s: %s", pnh.getNamespace().c_str(), message.c_str());
+  }
 };
 
 FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
@@ -219,40 +164,20 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   Impl& m = *impl_;
   m.nh = nh;
   m.pnh = pnh;
-  RosParamSource params(pnh);
-  m.options = ReadFusionNodeOptions(params);
-  for (const std::string& n : UnknownFusionNodeParams(params))
-    ROS_WARN(
-        "%s: unknown parameter '%s' (ignored; see config/fusion_node.yaml)",
-        pnh.getNamespace().c_str(), n.c_str());
-  if (StripLeadingSlash(m.options.world_frame) != m.options.world_frame) {
-    // tf2 frame ids have no leading '/'.
-    const std::string w = StripLeadingSlash(m.options.world_frame);
-    ROS_WARN("%s: world_frame '%s' starts with '/': using '%s'",
-             pnh.getNamespace().c_str(), m.options.world_frame.c_str(),
-             w.c_str());
-    m.options.world_frame = w;
-  }
+  m.options = LoadFusionNodeOptions(pnh);
   m.drops.set_throttle(m.options.error_throttle);
   m.drops.set_window(m.options.drop_window);
   const FusionNodeOptions& o = m.options;
   m.session = std::make_unique<FusionSession>(
-      SessionOptions(o),
+      o.session,
       [&m](const std::string& problem, const std::string& detail) {
         m.Drop(problem, detail);
       },
-      [&m](bool error, const std::string& message) {
-        if (error)
-          ROS_ERROR("%s: %s", m.pnh.getNamespace().c_str(), message.c_str());
-        else
-          ROS_INFO("%s: %s", m.pnh.getNamespace().c_str(), message.c_str());
-      });
+      [&m](bool error, const std::string& message) { m.Log(error, message); });
   m.queue = std::make_unique<WorkQueue<wild_mvs::DepthViewConstPtr>>(
       o.input_queue_size,
       [&m](wild_mvs::DepthViewConstPtr msg) { m.Work(msg); });
-  m.cloud_pub = m.pnh.advertise<sensor_msgs::PointCloud2>("cloud", 1, true);
-  if (o.mesh_period > 0)
-    m.mesh_pub = m.pnh.advertise<visualization_msgs::Marker>("mesh", 1, true);
+  m.outputs = std::make_unique<FusionOutputs>(m.pnh, o, m.session.get());
   m.save_srv = m.pnh.advertiseService("save", &Impl::OnSave, &m);
   m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
   m.view_rate = std::make_unique<RateStatus>(
@@ -262,9 +187,6 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.ledger = std::make_unique<KeyframeLedger>(o.keyframes);
   m.sub = m.nh.subscribe("depth_view", o.input_queue_size, &Impl::OnView, &m);
   m.index_sub = m.nh.subscribe("keyframe_index", 10, &Impl::OnIndex, &m);
-  m.output_worker.Every(o.publish_period, [&m] { m.PublishCloud(false); });
-  if (o.mesh_period > 0)
-    m.mesh_worker.Every(o.mesh_period, [&m] { m.PublishMesh(); });
   m.updater = std::make_unique<diagnostic_updater::Updater>(
       m.nh, m.pnh, m.pnh.getNamespace());
   m.updater->setHardwareID("wild_mvs_fusion");
@@ -274,20 +196,19 @@ FusionNode::FusionNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       ros::WallDuration(o.diagnostics_period),
       [&m](const ros::SteadyTimerEvent&) { m.updater->force_update(); });
   m.queue->Start();  // the fusion thread
-  m.output_worker.Start();
-  m.mesh_worker.Start();
+  m.outputs->Start();
 }
 
-size_t FusionNode::Save(const std::string& path) { return impl_->Save(path); }
+size_t FusionNode::Save(const std::string& path) {
+  return impl_->outputs->Save(path);
+}
 
 FusionNode::~FusionNode() {
   Impl& m = *impl_;
   m.sub.shutdown();
   m.index_sub.shutdown();
   m.diag_timer.stop();
-  // A running mesh or publication finishes; nothing new starts.
-  m.mesh_worker.Stop();
-  m.output_worker.Stop();
+  m.outputs->Stop();
   // Views already queued are fused before the final save.
   for (const auto& msg : m.queue->Stop()) {
     try {
@@ -295,13 +216,14 @@ FusionNode::~FusionNode() {
     } catch (const std::exception&) {
     }
   }
-  if (!m.options.output_path.empty()) {
+  const std::string& path = m.options.session.output_path;
+  if (!path.empty()) {
     try {
-      const size_t n = m.Save(m.options.output_path);
+      const size_t n = m.outputs->Save(path);
       ROS_INFO("%s: saved %zu points to %s on shutdown",
-               m.pnh.getNamespace().c_str(), n, m.options.output_path.c_str());
+               m.pnh.getNamespace().c_str(), n, path.c_str());
       std::fprintf(stderr, "fusion node: saved %zu points to %s\n", n,
-                   m.options.output_path.c_str());
+                   path.c_str());
     } catch (const std::exception& e) {
       ROS_ERROR("%s: saving on shutdown failed: %s",
                 m.pnh.getNamespace().c_str(), e.what());

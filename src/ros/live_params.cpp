@@ -221,5 +221,22 @@ bool LiveParams::OnSet(dynamic_reconfigure::Reconfigure::Request& req,
   return true;
 }
 
+DepthLiveParams::DepthLiveParams(
+    const ros::NodeHandle& private_nh, const DepthNodeOptions& options,
+    std::function<void(const StreamOptions&)> apply)
+    : live_(options) {
+  RegisterOptions(&registry_, "", &live_);
+  params_ = std::make_unique<LiveParams>(
+      private_nh, &registry_,
+      std::vector<std::string>{
+          "keyframe_min_baseline", "keyframe_min_angle_deg",
+          "mvs.max_image_size", "mvs.global.num_neighbors", "mvs.local.min_ncc",
+          "mvs.mpgc.drop_ncc", "mvs.growing.revisit_margin"},
+      [this, apply] {
+        live_.Check();
+        apply(live_.stream);
+      });
+}
+
 }  // namespace ros1
 }  // namespace wild_mvs

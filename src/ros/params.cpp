@@ -175,16 +175,8 @@ void FusionNodeOptions::Check() const {
       "drop_window = ", drop_window, " must be in [0.1, 86400] s");
   Require(max_published_points >= 0,
           "max_published_points = ", max_published_points, " must be >= 0");
-  Require(std::isfinite(reorder_timeout) && reorder_timeout >= 0,
-          "reorder_timeout = ", reorder_timeout, " must be >= 0");
-  Require(std::isfinite(revision_timeout) && revision_timeout >= 0,
-          "revision_timeout = ", revision_timeout, " must be >= 0");
-  Require(on_new_session == "keep" || on_new_session == "reset",
-          "on_new_session = '", on_new_session, "' must be 'keep' or 'reset'");
-  Require(std::isfinite(map_store_mb) && map_store_mb > 0,
-          "map_store_mb = ", map_store_mb, " must be > 0");
   keyframes.Check();
-  fusion.Check();
+  session.Check();
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -277,7 +269,7 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("mesh_period"), &o->mesh_period,
             "s between mesh Markers (Poisson), 0 = no mesh")
       .Min(0);
-  registry->Add(key("output_path"), &o->output_path,
+  registry->Add(key("output_path"), &o->session.output_path,
                 "PLY saved on shutdown (SIGINT / SIGTERM) when set");
   registry
       ->Add(key("input_queue_size"), &o->input_queue_size,
@@ -285,25 +277,25 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(1)
       .Max(1000);
   registry
-      ->Add(key("reorder_timeout"), &o->reorder_timeout,
+      ->Add(key("reorder_timeout"), &o->session.reorder_timeout,
             "s a view waits for a missing earlier keyframe (several workers)")
       .Min(0);
   registry
-      ->Add(key("revision_timeout"), &o->revision_timeout,
+      ->Add(key("revision_timeout"), &o->session.revision_timeout,
             "s a view waits for its keyframe's final revision before it is "
             "fused as it is (0 = never waits)")
       .Min(0);
   registry
-      ->Add(key("on_new_session"), &o->on_new_session,
+      ->Add(key("on_new_session"), &o->session.on_new_session,
             "depth node reset/restarted (DepthView.session): keep = same "
             "cloud, reset = save it as <output>_session<N>.ply and start a "
             "new one")
       .OneOf({"keep", "reset"});
   registry
-      ->Add(key("map_store_mb"), &o->map_store_mb,
+      ->Add(key("map_store_mb"), &o->session.map_store_mb,
             "depth maps kept in memory; older ones spill to spill_dir")
       .Above(0);
-  registry->Add(key("spill_dir"), &o->spill_dir,
+  registry->Add(key("spill_dir"), &o->session.spill_dir,
                 "\"\" = a temporary folder, removed at exit");
   registry
       ->Add(key("max_published_points"), &o->max_published_points,
@@ -333,7 +325,7 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(1);
   // The core's fusion options, with the node's smaller memory budgets
   // (map_cache_mb 256, pending_mb 128; the CLI's are 512 and 256).
-  RegisterOptions(registry, key("fusion"), &o->fusion);
+  RegisterOptions(registry, key("fusion"), &o->session.fusion);
 }
 
 DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params) {

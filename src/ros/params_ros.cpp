@@ -1,9 +1,11 @@
 // Copyright wild_mvs authors.
 #include "wild_mvs/ros/params_ros.h"
 
+#include <ros/console.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/ros/conversions.h"
 
 namespace wild_mvs {
 namespace ros1 {
@@ -39,6 +41,31 @@ std::vector<std::string> RosParamSource::Names() const {
     if (n.compare(0, prefix.size(), prefix) == 0)
       out.push_back(n.substr(prefix.size()));
   return out;
+}
+
+DepthNodeOptions LoadDepthNodeOptions(const ros::NodeHandle& pnh) {
+  RosParamSource params(pnh);
+  DepthNodeOptions o = ReadDepthNodeOptions(params);
+  for (const std::string& n : UnknownDepthNodeParams(params))
+    ROS_WARN("%s: unknown parameter '%s' (ignored; see config/depth_node.yaml)",
+             pnh.getNamespace().c_str(), n.c_str());
+  return o;
+}
+
+FusionNodeOptions LoadFusionNodeOptions(const ros::NodeHandle& pnh) {
+  RosParamSource params(pnh);
+  FusionNodeOptions o = ReadFusionNodeOptions(params);
+  for (const std::string& n : UnknownFusionNodeParams(params))
+    ROS_WARN(
+        "%s: unknown parameter '%s' (ignored; see config/fusion_node.yaml)",
+        pnh.getNamespace().c_str(), n.c_str());
+  const std::string w = StripLeadingSlash(o.world_frame);
+  if (w != o.world_frame) {
+    ROS_WARN("%s: world_frame '%s' starts with '/': using '%s'",
+             pnh.getNamespace().c_str(), o.world_frame.c_str(), w.c_str());
+    o.world_frame = w;
+  }
+  return o;
 }
 
 }  // namespace ros1

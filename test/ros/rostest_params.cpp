@@ -71,9 +71,9 @@ TEST(Params, ReconstructYamlLoadsIntoTheNodes) {
   OptionRegistry fusion;
   RegisterOptions(&fusion, "", &f);
   ExpectSameValues(cli, fusion, "fusion");  // bbox .inf included
-  EXPECT_EQ(f.fusion.min_support, 2);
-  EXPECT_EQ(f.fusion.bbox_max[2], std::optional<double>(10.0));
-  EXPECT_FALSE(f.fusion.bbox_min[0].has_value());
+  EXPECT_EQ(f.session.fusion.min_support, 2);
+  EXPECT_EQ(f.session.fusion.bbox_max[2], std::optional<double>(10.0));
+  EXPECT_FALSE(f.session.fusion.bbox_min[0].has_value());
 }
 
 // The depth node started with depth_node.yaml + the tuned file comes up

@@ -23,8 +23,8 @@ TEST(Params, DefaultsAreValid) {
   EXPECT_TRUE(d.stream.use_tracker);
   EXPECT_EQ(d.stream.mvs.global.num_neighbors, 10);  // paper default kept
   const FusionNodeOptions f = ReadFusionNodeOptions(none);
-  EXPECT_EQ(f.fusion.min_support, FusionOptions().min_support);
-  EXPECT_EQ(f.on_new_session, "keep");
+  EXPECT_EQ(f.session.fusion.min_support, FusionOptions().min_support);
+  EXPECT_EQ(f.session.on_new_session, "keep");
 }
 
 TEST(Params, ValuesReachTheCoreOptions) {
@@ -67,9 +67,9 @@ TEST(Params, ValuesReachTheCoreOptions) {
                     {"fusion/depth_tolerance", 0.02}});
   const FusionNodeOptions f = ReadFusionNodeOptions(q);
   EXPECT_DOUBLE_EQ(f.publish_period, 0.5);
-  EXPECT_EQ(f.output_path, "/tmp/x.ply");
-  EXPECT_EQ(f.fusion.min_support, 2);
-  EXPECT_DOUBLE_EQ(f.fusion.depth_tolerance, 0.02);
+  EXPECT_EQ(f.session.output_path, "/tmp/x.ply");
+  EXPECT_EQ(f.session.fusion.min_support, 2);
+  EXPECT_DOUBLE_EQ(f.session.fusion.depth_tolerance, 0.02);
 }
 
 // What rosparam makes of a YAML document loaded into a namespace: nested
@@ -121,10 +121,10 @@ TEST(Params, ConfigFilesLoadAsTheDefaults) {
   EXPECT_TRUE(UnknownFusionNodeParams(fusion).empty());
   const FusionNodeOptions f = ReadFusionNodeOptions(fusion);
   // The fusion node's memory budgets are below the core's (CLI) defaults.
-  EXPECT_DOUBLE_EQ(f.map_store_mb, 256.0);
-  EXPECT_LT(f.fusion.map_cache_mb, FusionOptions().map_cache_mb);
-  EXPECT_LT(f.fusion.pending_mb, FusionOptions().pending_mb);
-  EXPECT_FALSE(f.fusion.bbox_min[0].has_value());
+  EXPECT_DOUBLE_EQ(f.session.map_store_mb, 256.0);
+  EXPECT_LT(f.session.fusion.map_cache_mb, FusionOptions().map_cache_mb);
+  EXPECT_LT(f.session.fusion.pending_mb, FusionOptions().pending_mb);
+  EXPECT_FALSE(f.session.fusion.bbox_min[0].has_value());
   // Every parameter is in the file.
   DepthNodeOptions o;
   OptionRegistry r;
@@ -232,7 +232,7 @@ TEST(Params, BadValuesNameTheParameter) {
   // Reset policy of the fusion node: keep or reset, nothing else.
   EXPECT_EQ(ReadFusionNodeOptions(
                 MapParamSource({{"on_new_session", std::string("reset")}}))
-                .on_new_session,
+                .session.on_new_session,
             "reset");
   try {
     ReadFusionNodeOptions(

@@ -95,9 +95,10 @@ class DepthInputs {
   // The subscribed topics (resolved) and what a full roscpp queue of each
   // means (RoscppDropWatch's hint).
   std::map<std::string, std::string> QueueParams() const;
-  const std::string& image_topic() const { return image_topic_; }
-  const std::string& info_topic() const { return info_topic_; }
-  bool rectified() const { return rectified_; }
+  // "images <topic> (<transport>[, rectified]), camera_info <topic> (...),
+  // pose from ..., sparse points from ..., world frame '...'" for the
+  // node's start message.
+  std::string Describe() const;
   // A frame id as tf2 wants it: without leading '/' (tf2 rejects them, and
   // many recorded bags have them); warns once per frame id.
   std::string NoSlash(const std::string& frame_id);

@@ -1,6 +1,6 @@
 // Copyright wild_mvs authors. The fusion node's messages around the
-// ROS-free FusionSession: a DepthView decoded into a FusionView, the node's
-// options as session options, and its diagnostics.
+// ROS-free FusionSession: a DepthView decoded into a FusionView, and the
+// node's diagnostics.
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
@@ -22,8 +22,6 @@ namespace ros1 {
 // map's size, keyframe id, session, stamps; `arrived` = now). Throws Error
 // for an invalid message.
 FusionView FusionViewFromMsg(const wild_mvs::DepthView& msg);
-
-FusionSessionOptions SessionOptions(const FusionNodeOptions& options);
 
 void FillFusionDiagnostics(const FusionSessionStats& s, uint64_t received,
                            size_t queued, const DropCounter& drops,

@@ -13,11 +13,13 @@
 #include <ros/node_handle.h>
 
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "wild_mvs/core/option_registry.h"
+#include "wild_mvs/ros/params.h"
 
 namespace wild_mvs {
 namespace ros1 {
@@ -51,6 +53,23 @@ class LiveParams {
   std::string last_error_;
   ros::Publisher descriptions_pub_, updates_pub_;
   ros::ServiceServer set_srv_;
+};
+
+// The depth node's live parameters: the keyframe thresholds and the main
+// MVS thresholds (keyframe_min_baseline, keyframe_min_angle_deg,
+// mvs/max_image_size, mvs/global/num_neighbors, mvs/local/min_ncc,
+// mvs/mpgc/drop_ncc, mvs/growing/revisit_margin) over a copy of the node's
+// options; a change DepthNodeOptions::Check() accepts goes to `apply`.
+class DepthLiveParams {
+ public:
+  DepthLiveParams(const ros::NodeHandle& private_nh,
+                  const DepthNodeOptions& options,
+                  std::function<void(const StreamOptions&)> apply);
+
+ private:
+  DepthNodeOptions live_;
+  OptionRegistry registry_;
+  std::unique_ptr<LiveParams> params_;
 };
 
 }  // namespace ros1

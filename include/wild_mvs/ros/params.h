@@ -26,6 +26,7 @@
 
 #include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/option_registry.h"
+#include "wild_mvs/stream/fusion_session.h"
 #include "wild_mvs/stream/keyframe_ledger.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
 
@@ -173,7 +174,6 @@ struct FusionNodeOptions {
   std::string world_frame = "world";
   double publish_period = 1.0;  // s, at most one cloud per period (latched)
   double mesh_period = 0.0;     // s, mesh Marker period; 0 = no mesh
-  std::string output_path;      // PLY written on shutdown when set
   int input_queue_size = 10;    // depth views waiting to be fused
   double diagnostics_period = 1.0;
   double error_throttle = 5.0;  // s between repeated errors about a problem
@@ -183,49 +183,35 @@ struct FusionNodeOptions {
   // Cloud published for rviz: at most this many points (uniform subsample);
   // the saved PLY always has all points. 0 = no limit.
   int max_published_points = 500000;
-  // Fusion is done in keyframe-id order: a view waits at most this long (s)
-  // for a missing earlier keyframe (several workers deliver out of order).
-  double reorder_timeout = 2.0;
-  // A view that is not its keyframe's final revision (DepthView) waits at
-  // most this long (s) for it before it is fused as it is; 0 = never waits.
-  double revision_timeout = 30.0;
-  // What a new depth-node session (DepthView.session: the depth node reset
-  // on a bag loop or pose jump, or was restarted) does to the cloud:
-  // "keep" = fuse it into the same cloud (the world frame is the same);
-  // "reset" = save the cloud so far to <output_path stem>_session<N>.ply
-  // (when output_path is set) and start a new cloud (the world frame was
-  // redefined, e.g. a SLAM map reset). Views of an earlier session that
-  // arrive late are fused ("keep") or dropped, counted ("reset").
-  std::string on_new_session = "keep";
   // A keyframe a selector announced (`keyframe_index`) without a depth view
   // after this many seconds is named missing in diagnostics; a second
   // first depth view of a keyframe is named done twice.
   KeyframeLedgerOptions keyframes;
-  // Depth maps held in memory for the consistency checks; older ones are
-  // spilled to spill_dir (a temporary folder when empty) and read back when
-  // needed, so memory stays bounded on long runs.
-  double map_store_mb = 256;
-  std::string spill_dir;
-  // The core's fusion options, with the node's smaller memory budgets (the
-  // node shares its robot with other processes): map cache 256 MB (the
-  // core's default 512), pending samples 128 MB (256). With map_store_mb the
-  // node's bounded memory is 640 MB plus the cloud.
-  FusionOptions fusion = NodeFusionDefaults();
+  // Reordering, revisions, the session policy, the depth map store and the
+  // core's fusion options (FusionSessionOptions); its fields are top-level
+  // parameters (output_path, reorder_timeout, revision_timeout,
+  // on_new_session, map_store_mb, spill_dir) and the section fusion/.
+  // output_path is also where the cloud is saved on shutdown. The node's
+  // fusion memory budgets are smaller than the core's (the node shares its
+  // robot with other processes): map cache 256 MB (the core's default 512),
+  // pending samples 128 MB (256). With map_store_mb the node's bounded
+  // memory is 640 MB plus the cloud.
+  FusionSessionOptions session = NodeSessionDefaults();
   void Check() const;
 
-  static FusionOptions NodeFusionDefaults() {
-    FusionOptions f;
-    f.map_cache_mb = 256;
-    f.pending_mb = 128;
-    return f;
+  static FusionSessionOptions NodeSessionDefaults() {
+    FusionSessionOptions s;
+    s.fusion.map_cache_mb = 256;
+    s.fusion.pending_mb = 128;
+    return s;
   }
 };
 
 // The nodes' option structs in the registry. The depth node's own options
 // and its StreamOptions are top-level parameters (world_frame, num_threads,
 // keyframe_min_baseline, ...); StreamOptions::mvs and ::tracker are the
-// sections mvs/ and tracker/, FusionNodeOptions::fusion is fusion/, with the
-// core's keys (mvs/mpgc/drop_ncc). `prefix` is "" for a node.
+// sections mvs/ and tracker/, FusionNodeOptions::session.fusion is fusion/,
+// with the core's keys (mvs/mpgc/drop_ncc). `prefix` is "" for a node.
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      DepthNodeOptions* options);
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,

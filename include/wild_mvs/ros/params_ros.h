@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors. ParamSource over a ros::NodeHandle (the
-// node's private namespace).
+// node's private namespace), and the nodes' options read from it.
 #pragma once
 
 #include <ros/node_handle.h>
@@ -23,6 +23,13 @@ class RosParamSource : public ParamSource {
  private:
   ros::NodeHandle nh_;
 };
+
+// A node's options from its private parameters (Read*NodeOptions: throws
+// Error on a bad value); each unknown parameter is warned about
+// (ROS_WARN), naming the config file that lists the known ones. The fusion
+// node's world_frame loses a leading '/' (tf2 frame ids have none; warned).
+DepthNodeOptions LoadDepthNodeOptions(const ros::NodeHandle& private_nh);
+FusionNodeOptions LoadFusionNodeOptions(const ros::NodeHandle& private_nh);
 
 }  // namespace ros1
 }  // namespace wild_mvs

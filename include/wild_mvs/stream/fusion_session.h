@@ -95,13 +95,19 @@ class ReorderBuffer {
 };
 
 struct FusionSessionOptions {
-  // The fusion node's parameters of the same names (FusionNodeOptions).
-  double reorder_timeout = 2.0;         // s
-  double revision_timeout = 30.0;       // s
-  std::string on_new_session = "keep";  // "keep" or "reset"
-  std::string output_path;              // stem of the session saves ("" = none)
+  // A view waits at most this long (s, >= 0) for a missing earlier keyframe.
+  double reorder_timeout = 2.0;
+  // A view that is not its keyframe's final revision waits at most this
+  // long (s, >= 0) for it; 0 = never waits.
+  double revision_timeout = 30.0;
+  // A new session: "keep" = fuse it into the same cloud; "reset" = save the
+  // cloud so far (see output_path) and start a new one.
+  std::string on_new_session = "keep";
+  // Stem of the session saves <stem>_session<N>.ply; "" = none.
+  std::string output_path;
+  // Depth maps held in memory (MB, > 0); older ones spill to spill_dir.
   double map_store_mb = 256;
-  std::string spill_dir;  // "" = a temporary folder
+  std::string spill_dir;  // "" = a temporary folder, removed at the end
   FusionOptions fusion;
   void Check() const;
 };
