@@ -12,7 +12,11 @@
 #   families  bench/run_families.sh: the rendered scene families with
 #             exact ground truth (relief, weak, courtyard), report seeds;
 #   scale     bench/run_scale.sh: CPU-s per view and peak RSS against the
-#             number of views (100 / 250 / 500).
+#             number of views (100 / 250 / 500);
+#   live      bench/run_live.sh: the depth and fusion nodes on a bag of a
+#             rendered scene against `wild_mvs reconstruct` on the same
+#             images (relief and courtyard light, seed 101); needs the ROS
+#             build in build/ (scripts/run_tests.sh makes it), else not run.
 # Peers: with OPENMVS_BIN (the folder of OpenMVS's InterfaceCOLMAP and
 # DensifyPointCloud) OpenMVS runs beside wild_mvs (full setting only);
 # otherwise, and for MVE (no runner here), RESULTS.md shows their recorded
@@ -25,7 +29,7 @@
 #                collections of 10 / 20 / 40 views at 160 px): minutes
 #                instead of hours; RESULTS.md says so at the top
 #   --skip LIST  comma-separated sections not to run (speed, fountain,
-#                families, scale); RESULTS.md lists them as not run
+#                families, scale, live); RESULTS.md lists them as not run
 #   --out DIR    raw outputs (default bench/out/all-<UTC time>, ignored by git)
 # Environment: WILD_MVS_DATASETS (default ../shared/datasets of the repo;
 # fountain needs it, temple uses its GT model when present), BUILD_DIR
@@ -53,8 +57,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 for s in ${SKIP//,/ }; do
-  case "$s" in speed | fountain | families | scale) ;; *)
-    echo "run_all.sh: --skip takes speed, fountain, families, scale; not '$s'" >&2; exit 2 ;;
+  case "$s" in speed | fountain | families | scale | live) ;; *)
+    echo "run_all.sh: --skip takes speed, fountain, families, scale, live; not '$s'" >&2; exit 2 ;;
   esac
 done
 skipped() { [[ ",$SKIP," == *",$1,"* ]]; }
@@ -138,6 +142,16 @@ if ! skipped scale; then
   bash "$ROOT/bench/run_scale.sh" $SCALE_ARGS --work "$OUT/scale_work" \
     --results "$OUT/scale" || failed scale
 fi
+LIVE_NOTE=""
+if ! skipped live; then
+  if [ -x "$ROOT/devel/lib/wild_mvs/bench_live_depth_maps" ]; then
+    BUILD_DIR="$ROOT/build" bash "$ROOT/bench/run_live.sh" --skip-build \
+      --families "relief courtyard" --seeds 101 --size "${SCENE_SIZE%x*}" \
+      --out "$OUT/live" || failed live
+  else
+    LIVE_NOTE="Not run: needs the ROS build in build/ (bash scripts/run_tests.sh makes it)."
+  fi
+fi
 
 # Peers beside wild_mvs, where their binaries are given (full setting only:
 # their recorded figures are at the full sizes). MVE has no runner here.
@@ -191,6 +205,8 @@ fi
   printf 'failed\t%s\n' "$FAILED"
   printf 'families_note\t%s\n' "$FAMILIES_NOTE"
   printf 'scale_args\t%s\n' "$SCALE_ARGS"
+  printf 'live_note\t%s\n' "$LIVE_NOTE"
+  printf 'scene_size\t%s\n' "$SCENE_SIZE"
 } >"$OUT/meta.tsv"
 "$PY" "$ROOT/bench/make_results.py" "$OUT" "$ROOT"
 echo "run_all.sh: wrote docs/RESULTS.md, docs/results_*.png and README's results block (raw outputs in $OUT)" >&2

@@ -788,6 +788,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(1);
   // use_tracker follows the node's sparse_source.
   RegisterOptions(registry, key("mvs"), &o->mvs);
+  // The revisions' consistency step: the CLI's consistency.* keys.
+  RegisterOptions(registry, key("consistency"), &o->mvs.consistency);
   RegisterOptions(registry, key("tracker"), &o->tracker);
 }
 
