@@ -10,6 +10,12 @@
 #
 #   bench/run_live.sh [--families "relief courtyard"] [--seeds 101]
 #                     [--size 640] [--rate 1] [--out DIR] [--skip-build]
+#                     [--sparse tracker|topic]
+#
+# --sparse: where the depth node's sparse points come from: its own
+# incremental tracker (default, as a robot runs it), or the dataset's
+# sparse model written into the bag (/sparse_points, sparse_source:=topic),
+# the points the offline run uses: then the two differ only in the pipeline.
 #
 # Needs the ROS build (scripts/common.sh's BUILD_DIR, default build/). Runs
 # its own roscore on a free port. Prints one row per scene and run and
@@ -21,6 +27,7 @@ FAMILIES="relief courtyard"
 SEEDS=101
 SIZE=640
 RATE=1
+SPARSE=tracker
 BUILD=missing
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
@@ -30,11 +37,15 @@ while [ $# -gt 0 ]; do
     --size) SIZE="$2"; shift 2 ;;
     --rate) RATE="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
+    --sparse) SPARSE="$2"; shift 2 ;;
     --skip-build) BUILD=never; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "run_live.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
+case "$SPARSE" in tracker|topic) ;; *)
+  echo "run_live.sh: --sparse $SPARSE must be tracker or topic" >&2; exit 2 ;;
+esac
 source "$ROOT/scripts/common.sh"
 DEVEL="$BUILD_DIR/../devel"
 [ -d "$DEVEL" ] || DEVEL="$ROOT/devel"
@@ -106,13 +117,17 @@ for family in $FAMILIES; do
     printf '%s\t%s\toffline\t%s/%s\t%s\t%s\t%.1f\n' "$kind" "$seed" "$n" "$nviews" \
       "${off// /	}" "${f// /	}" "$(echo "$u + $s" | bc)" >>"$TSV"
     # Live.
-    "$BIN/wild_mvs_to_bag" "$scene" "$run/scene.bag" --rate "$RATE" >"$run/bag.log" 2>&1
+    points=()
+    [ "$SPARSE" = topic ] && points=(--with-points)
+    "$BIN/wild_mvs_to_bag" "$scene" "$run/scene.bag" --rate "$RATE" \
+      ${points[@]+"${points[@]}"} >"$run/bag.log" 2>&1
     roscore -p "$PORT" >"$run/roscore.log" 2>&1 &
     core=$!
     sleep 3
     /usr/bin/time -f '%U %S' -o "$run/live.time" \
       roslaunch wild_mvs reconstruct_bag.launch bag:="$run/scene.bag" \
-      output:="$run/live_fused.ply" record:="$run/live.bag" >"$run/live.log" 2>&1 || true
+      output:="$run/live_fused.ply" record:="$run/live.bag" \
+      sparse_source:="$SPARSE" >"$run/live.log" 2>&1 || true
     kill "$core" 2>/dev/null || true
     wait "$core" 2>/dev/null || true
     read -r u s <"$run/live.time"

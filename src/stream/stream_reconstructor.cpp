@@ -89,6 +89,7 @@ void StreamReconstructor::ClearLocked() {
   in_flight_.clear();
   maps_.clear();
   unrevised_.clear();
+  rematched_.clear();
   revising_.clear();
   ++generation_;
   next_id_ = 0;  // ids restart in the new session
@@ -401,23 +402,39 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
 
 void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
   // First matches go first (a new keyframe's map is what a robot waits
-  // for); then one revision at a time, so a new keyframe waits for at most
-  // one.
+  // for); then one revision step at a time, so a new keyframe waits for at
+  // most one.
   if (stopping_ || !in_flight_.empty() || !revising_.empty()) return;
-  for (const auto& [id, first] : unrevised_) {
-    // Every neighbour it was matched against is done (a neighbour no longer
-    // held is done too); at the idle flush, with nothing being matched,
-    // neighbours that cannot be matched yet are not waited for.
+  // A neighbour is settled for step `rematched` when the store no longer
+  // holds it, another worker owns it, its matching failed, or it reached
+  // that step.
+  auto settled = [this](uint32_t n, bool rematched) {
+    const KeyframePtr k = store_.Get(n);
+    if (!k || !k->owned) return true;
+    if (k->reconstructions > 0 && !maps_.count(n)) return true;  // failed
+    return rematched ? rematched_.count(n) > 0
+                     : k->done() && !in_flight_.count(n);
+  };
+  for (const auto& [id, pending] : unrevised_) {
+    // Step 1, matching again, once the neighbours of the first match are
+    // matched; step 2, the filter, once the new neighbours are matched
+    // again too (their maps are then what the offline filter would see).
+    // At the idle flush nothing is waited for.
+    const bool rematched = rematched_.count(id) > 0;
     bool ready = true;
-    for (uint32_t n : first.neighbor_ids) {
-      const KeyframePtr k = store_.Get(n);
-      if (k && (!k->done() || in_flight_.count(n))) ready = false;
-    }
+    for (uint32_t n : pending.neighbor_ids)
+      if (n != id && !settled(n, rematched)) ready = false;
     if (!ready && !idle) continue;
     revising_.insert(id);
     const uint64_t gen = generation_;
     const uint32_t rid = id;
-    dispatcher_->Submit([this, rid, gen] { RunRevision(rid, gen); });
+    dispatcher_->Submit([this, rid, gen, rematched] {
+      if (rematched) {
+        RunRevisionFilter(rid, gen);
+      } else {
+        RunRevisionMatch(rid, gen);
+      }
+    });
     return;
   }
 }
@@ -425,6 +442,7 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
 void StreamReconstructor::ForgetLocked(uint32_t id) {
   maps_.erase(id);
   unrevised_.erase(id);
+  rematched_.erase(id);
 }
 
 double StreamReconstructor::MatchKeyframe(const Snapshot& snap, int ref,
@@ -453,7 +471,7 @@ double StreamReconstructor::MatchKeyframe(const Snapshot& snap, int ref,
   return score;
 }
 
-void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
+void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
   StreamResult result;
   Snapshot snap;
   int ref = -1;
@@ -468,55 +486,79 @@ void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
       return;
     }
     result = it->second;
-    if (store_.Get(id)) {
-      snap = MakeSnapshotLocked();
-      for (size_t i = 0; i < snap.keyframes.size(); ++i)
-        if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
-    }
+    snap = MakeSnapshotLocked();
+    for (size_t i = 0; i < snap.keyframes.size(); ++i)
+      if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
     mvs = options_.mvs;
     ++stats_.running;
   }
-  const auto t0 = std::chrono::steady_clock::now();
+  // Matched again over every keyframe held: its neighbours on both sides
+  // exist now (the offline view selection).
   std::string error;
   try {
-    // 1. Matched again, over every keyframe held: its neighbours on both
-    // sides exist now (the offline view selection). A keyframe the store
-    // no longer holds keeps its first map.
-    if (ref >= 0) {
-      MatchKeyframe(snap, ref, mvs, &result);
-    } else {  // the first result's arrays were delivered: work on copies
-      result.depth.depth = result.depth.depth.clone();
-      result.depth.normal = result.depth.normal.clone();
-      result.depth.confidence = result.depth.confidence.clone();
-    }
-    // 2. The consistency step against the neighbours' latest raw maps; the
-    // new raw map is what later revisions check against.
-    std::vector<std::shared_ptr<const DepthMap>> held;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (uint32_t n : result.neighbor_ids) {
-        auto m = maps_.find(n);
-        if (m != maps_.end()) held.push_back(m->second);
-      }
-      if (ref >= 0 && generation == generation_ && maps_.count(id)) {
-        auto depth_only = std::make_shared<DepthMap>();
-        depth_only->view = result.depth.view;
-        depth_only->camera = result.depth.camera;
-        depth_only->depth = result.depth.depth.clone();
-        maps_[id] = std::move(depth_only);
-      }
-    }
-    std::vector<const DepthMap*> neighbors;
-    for (const auto& m : held) neighbors.push_back(m.get());
-    ConsistencyStats stats;
-    FilterByConsistency(&result.depth, neighbors, mvs.consistency, &stats);
+    if (ref >= 0) MatchKeyframe(snap, ref, mvs, &result);
   } catch (const Cancelled&) {
     std::lock_guard<std::mutex> lock(mutex_);
     --stats_.running;
     ++stats_.cancelled;
     revising_.erase(id);
     idle_cv_.notify_all();
-    return;  // shutting down: nothing to deliver
+    return;  // shutting down
+  } catch (const std::exception& e) {
+    error = e.what();  // the first map stays; the filter still runs
+  }
+  if (!error.empty() && on_error_)
+    on_error_(Msg("keyframe ", id, ": matching again failed: ", error));
+  std::lock_guard<std::mutex> lock(mutex_);
+  --stats_.running;
+  auto it = unrevised_.find(id);
+  if (generation == generation_ && it != unrevised_.end()) {
+    if (ref >= 0 && error.empty()) {
+      it->second = result;
+      auto depth_only = std::make_shared<DepthMap>();
+      depth_only->view = result.depth.view;
+      depth_only->camera = result.depth.camera;
+      depth_only->depth = result.depth.depth;
+      maps_[id] = std::move(depth_only);
+    }
+    rematched_.insert(id);
+  }
+  revising_.erase(id);
+  ScheduleLocked();
+  idle_cv_.notify_all();
+}
+
+void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
+  StreamResult result;
+  std::vector<std::shared_ptr<const DepthMap>> held;
+  GeometricConsistencyOptions consistency;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = unrevised_.find(id);
+    if (stopping_ || generation != generation_ || it == unrevised_.end()) {
+      revising_.erase(id);
+      ScheduleLocked();
+      idle_cv_.notify_all();
+      return;
+    }
+    result = it->second;
+    for (uint32_t n : result.neighbor_ids) {
+      auto m = maps_.find(n);
+      if (m != maps_.end()) held.push_back(m->second);
+    }
+    consistency = options_.mvs.consistency;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  // The arrays may be shared with a delivered result or with maps_.
+  result.depth.depth = result.depth.depth.clone();
+  result.depth.normal = result.depth.normal.clone();
+  result.depth.confidence = result.depth.confidence.clone();
+  std::vector<const DepthMap*> neighbors;
+  for (const auto& m : held) neighbors.push_back(m.get());
+  std::string error;
+  try {
+    ConsistencyStats stats;
+    FilterByConsistency(&result.depth, neighbors, consistency, &stats);
   } catch (const std::exception& e) {
     error = e.what();
   }
@@ -528,7 +570,6 @@ void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
   bool deliver = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    --stats_.running;
     unrevised_.erase(id);
     if (generation != generation_) {
       ++stats_.stale_results;
@@ -542,8 +583,8 @@ void StreamReconstructor::RunRevision(uint32_t id, uint64_t generation) {
   if (!error.empty() && on_error_)
     on_error_(Msg("keyframe ", id, ": revision failed: ", error));
   if (deliver && on_result_) on_result_(result);
-  // Out of revising_ only now, and the next one scheduled under the same
-  // lock: WaitIdle never sees a gap between two revisions.
+  // Out of revising_ only now, and the next step scheduled under the same
+  // lock: WaitIdle never sees a gap between two steps.
   std::lock_guard<std::mutex> lock(mutex_);
   revising_.erase(id);
   ScheduleLocked();

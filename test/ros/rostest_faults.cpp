@@ -212,6 +212,9 @@ class Scenario {
                  "no /fusion_reset/output_path"))
       return false;
     session0 = reset_out.substr(0, reset_out.size() - 4) + "_session0.ply";
+    // The reset comes when the new session's first view is fused, which
+    // waits for that view's final revision (revision_timeout).
+    WaitFor([&] { return diag_.Get("fusion_reset: ", "resets") >= 1; }, 60);
     session0_saved = WaitFor([&] { return fs::exists(session0); }, 10);
     session0_vertices = PlyVertexCount(session0);
     reset_resets = diag_.Get("fusion_reset: ", "resets");

@@ -18,11 +18,12 @@
 // (mvs.ablation.consistency, as offline) it is then revised once, when
 // every neighbour it was matched against is done (matched by this worker,
 // owned by another, failed or evicted; or at the idle flush): matched again
-// over every keyframe held, so with neighbours on both sides as offline,
-// then checked against its neighbours' latest raw maps (FilterByConsistency
-// with mvs.consistency, the offline filter), and delivered as revision 1,
-// same stamp. First matches go first; one revision runs at a time, when no
-// first match is queued or running. Memory: the depth of every matched
+// over every keyframe held, so with neighbours on both sides as offline;
+// once those neighbours are matched again too (or at the idle flush), it is
+// checked against their maps (FilterByConsistency with mvs.consistency, the
+// offline filter on the maps offline would have) and delivered as revision
+// 1, same stamp. First matches go first; one revision step runs at a time,
+// when no first match is queued or running. Memory: the depth of every matched
 // keyframe held (4 bytes per pixel) and the first result of the keyframes
 // not yet revised; both go with the keyframe when the store evicts it.
 //
@@ -273,7 +274,8 @@ class StreamReconstructor {
   void RunReconstruction(uint32_t id, uint64_t generation);
   // Submits the revisions whose neighbours are done (see the file comment).
   void ScheduleRevisionsLocked(bool idle);
-  void RunRevision(uint32_t id, uint64_t generation);
+  void RunRevisionMatch(uint32_t id, uint64_t generation);   // step 1
+  void RunRevisionFilter(uint32_t id, uint64_t generation);  // step 2
   // Matches keyframe `ref` of `snap` (ReconstructView over the snapshot):
   // sets result->depth and its neighbours; returns the neighbour score.
   double MatchKeyframe(const Snapshot& snap, int ref, const MvsOptions& mvs,
@@ -297,6 +299,7 @@ class StreamReconstructor {
   // first results waiting for their revision, and revisions in flight.
   std::map<uint32_t, std::shared_ptr<const DepthMap>> maps_;
   std::map<uint32_t, StreamResult> unrevised_;
+  std::set<uint32_t> rematched_;  // held keyframes matched again (step 1)
   std::set<uint32_t> revising_;
   int ready_waiting_ = 0;
   uint32_t next_id_ = 0;
