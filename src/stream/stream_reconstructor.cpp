@@ -25,6 +25,16 @@ double StampSeconds(uint64_t stamp_ns) {
   return static_cast<double>(stamp_ns / 1000000000ull) +
          static_cast<double>(stamp_ns % 1000000000ull) * 1e-9;
 }
+
+// What a neighbour's revision needs of a matched map: its depth and camera
+// (the arrays are shared, not copied).
+std::shared_ptr<const DepthMap> DepthOnly(const DepthMap& map) {
+  auto d = std::make_shared<DepthMap>();
+  d->view = map.view;
+  d->camera = map.camera;
+  d->depth = map.depth;
+  return d;
+}
 }  // namespace
 
 void StreamOptions::Check() const {
@@ -439,6 +449,14 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
   }
 }
 
+void StreamReconstructor::EndRevisionStepLocked(uint32_t id) {
+  // Out of revising_ and the next step scheduled under the same lock:
+  // WaitIdle never sees a gap between two steps.
+  revising_.erase(id);
+  ScheduleLocked();
+  idle_cv_.notify_all();
+}
+
 void StreamReconstructor::ForgetLocked(uint32_t id) {
   maps_.erase(id);
   unrevised_.erase(id);
@@ -480,9 +498,7 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = unrevised_.find(id);
     if (stopping_ || generation != generation_ || it == unrevised_.end()) {
-      revising_.erase(id);
-      ScheduleLocked();
-      idle_cv_.notify_all();
+      EndRevisionStepLocked(id);
       return;
     }
     result = it->second;
@@ -515,17 +531,11 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
   if (generation == generation_ && it != unrevised_.end()) {
     if (ref >= 0 && error.empty()) {
       it->second = result;
-      auto depth_only = std::make_shared<DepthMap>();
-      depth_only->view = result.depth.view;
-      depth_only->camera = result.depth.camera;
-      depth_only->depth = result.depth.depth;
-      maps_[id] = std::move(depth_only);
+      maps_[id] = DepthOnly(result.depth);
     }
     rematched_.insert(id);
   }
-  revising_.erase(id);
-  ScheduleLocked();
-  idle_cv_.notify_all();
+  EndRevisionStepLocked(id);
 }
 
 void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
@@ -536,9 +546,7 @@ void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = unrevised_.find(id);
     if (stopping_ || generation != generation_ || it == unrevised_.end()) {
-      revising_.erase(id);
-      ScheduleLocked();
-      idle_cv_.notify_all();
+      EndRevisionStepLocked(id);
       return;
     }
     result = it->second;
@@ -583,12 +591,8 @@ void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
   if (!error.empty() && on_error_)
     on_error_(Msg("keyframe ", id, ": revision failed: ", error));
   if (deliver && on_result_) on_result_(result);
-  // Out of revising_ only now, and the next step scheduled under the same
-  // lock: WaitIdle never sees a gap between two steps.
   std::lock_guard<std::mutex> lock(mutex_);
-  revising_.erase(id);
-  ScheduleLocked();
-  idle_cv_.notify_all();
+  EndRevisionStepLocked(id);
 }
 
 void StreamReconstructor::Tick() {
@@ -672,11 +676,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       // With the consistency step a revision follows (ScheduleRevisions).
       result.final_revision = !mvs.ablation.consistency;
       if (!result.final_revision) {
-        auto depth_only = std::make_shared<DepthMap>();
-        depth_only->view = result.depth.view;
-        depth_only->camera = result.depth.camera;
-        depth_only->depth = result.depth.depth;
-        maps_[id] = std::move(depth_only);
+        maps_[id] = DepthOnly(result.depth);
         unrevised_[id] = result;
       }
       ++kf->reconstructions;

@@ -36,6 +36,7 @@
 #include <sstream>
 #include <vector>
 
+#include "pooled_depth_metrics.h"
 #include "real_world_bag.h"
 #include "ros_test_scene.h"
 #include "rostest_util.h"
@@ -447,21 +448,6 @@ TEST_F(RealBag, DepthMapsMatchTheGroundTruth) {
   }
 }
 
-// Pooled over the views: fraction of the ground truth with an estimate, of
-// the estimates within 1 % and off by more than 5 %.
-struct Pooled {
-  double gt = 0, evaluated = 0, in1 = 0, off5 = 0;
-  void Add(const DepthMetrics& m) {
-    gt += m.gt_valid;
-    evaluated += m.evaluated;
-    in1 += m.relative_accuracy[0] * m.evaluated;
-    off5 += (1 - m.relative_accuracy[2]) * m.evaluated;
-  }
-  double coverage() const { return gt > 0 ? evaluated / gt : 0; }
-  double within1() const { return evaluated > 0 ? in1 / evaluated : 0; }
-  double off5pc() const { return evaluated > 0 ? off5 / evaluated : 0; }
-};
-
 // The live path runs the offline pipeline's steps (matching, then the
 // consistency step as a revision): its final maps are as accurate as the
 // offline ones on the same images (sparse tracks from the known poses,
@@ -469,7 +455,8 @@ struct Pooled {
 TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
   const Playback& p = *playback_;
   ASSERT_FALSE(p.views.empty());
-  auto score = [&p](const wild_mvs::DepthView& msg, Pooled* pooled) {
+  auto score = [&p](const wild_mvs::DepthView& msg,
+                    PooledDepthMetrics* pooled) {
     const int v = p.ViewOf(msg.header.stamp);
     if (v < 0) return;
     cv::Mat d = ros1::FloatImageFromMsg(msg.depth, 1, "depth");
@@ -479,7 +466,7 @@ TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
     pooled->Add(EvaluateDepth(d, CameraOf(msg), p.scene.depth[v],
                               p.bag.view_cameras[v]));
   };
-  Pooled live, first;
+  PooledDepthMetrics live, first;
   for (const auto& [ns, msg] : p.views) {
     EXPECT_TRUE(msg->final_revision) << "view " << p.ViewOf(msg->header.stamp);
     score(*msg, &live);
@@ -501,7 +488,7 @@ TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
   for (size_t v = 0; v < scene.views.size(); ++v)
     raw[v] = ReconstructView(scene, static_cast<int>(v), images, mvs, &pool,
                              nullptr, cv::Mat());
-  Pooled offline;
+  PooledDepthMetrics offline;
   for (size_t v = 0; v < scene.views.size(); ++v) {
     DepthMap m = raw[v];
     m.depth = raw[v].depth.clone();

@@ -10,6 +10,7 @@
 #include <set>
 #include <thread>
 
+#include "pooled_depth_metrics.h"
 #include "ros_test_scene.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/geometric_consistency.h"
@@ -119,21 +120,6 @@ TEST(StreamReconstructor, DepthMapsMatchGroundTruth) {
   EXPECT_EQ(ids.size(), 6u);
 }
 
-// Pooled over views: ground truth with an estimate, estimates within 1 %
-// and off by more than 5 %.
-struct Pooled {
-  double gt = 0, evaluated = 0, in1 = 0, off5 = 0;
-  void Add(const DepthMetrics& m) {
-    gt += m.gt_valid;
-    evaluated += m.evaluated;
-    in1 += m.relative_accuracy[0] * m.evaluated;
-    off5 += (1 - m.relative_accuracy[2]) * m.evaluated;
-  }
-  double coverage() const { return evaluated / gt; }
-  double within1() const { return in1 / evaluated; }
-  double off5pc() const { return off5 / evaluated; }
-};
-
 // The live path runs the offline pipeline's steps: a keyframe is delivered
 // as matched, mostly against earlier keyframes (revision 0, not final),
 // then matched again once later keyframes exist, with neighbours on both
@@ -180,7 +166,7 @@ TEST(StreamReconstructor, FinalRevisionsAreTheOfflinePipelines) {
   for (int v = 0; v < n; ++v)
     raw[v] = ReconstructView(s.scene, v, images, options.mvs, &pool, nullptr,
                              cv::Mat());
-  Pooled offline, live_first, live_final;
+  testing::PooledDepthMetrics offline, live_first, live_final;
   for (int v = 0; v < n; ++v) {
     DepthMap m = raw[v];
     m.depth = raw[v].depth.clone();

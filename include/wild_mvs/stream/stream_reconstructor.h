@@ -280,7 +280,8 @@ class StreamReconstructor {
   // sets result->depth and its neighbours; returns the neighbour score.
   double MatchKeyframe(const Snapshot& snap, int ref, const MvsOptions& mvs,
                        StreamResult* result);
-  void ForgetLocked(uint32_t id);  // a keyframe left the store
+  void ForgetLocked(uint32_t id);           // a keyframe left the store
+  void EndRevisionStepLocked(uint32_t id);  // then schedules the next
   void ClearLocked();
 
   StreamOptions options_;
