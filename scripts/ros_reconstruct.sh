@@ -58,8 +58,8 @@ roslaunch -p "$PORT" wild_mvs reconstruct_bag.launch bag:="$OUT/input.bag" \
 end=$(date +%s.%N)
 grep -E "keyframe [0-9]+ \(rev|ERROR|FATAL" "$OUT/roslaunch.log" | sed 's/^/  /' || true
 seconds=$(/usr/bin/python3 -c "print(round($end-$start,1))")
-saved=$(grep -h "wild_mvs: saved" "$OUT/roslaunch.log" | tail -1)
-depth=$(grep -h "^depth node: " "$OUT/roslaunch.log" | tail -1)
+saved=$(grep -ho "wild_mvs: saved.*" "$OUT/roslaunch.log" | tail -1)
+depth=$(grep -ho "depth node: .*" "$OUT/roslaunch.log" | tail -1)
 if [ "$rc" != 0 ] || [ ! -s "$OUT/cloud.ply" ] || [ -z "$saved" ]; then
   echo "ros_reconstruct.sh: FAILED (roslaunch exit $rc, no saved cloud): see $OUT/roslaunch.log" >&2
   tail -20 "$OUT/roslaunch.log" >&2
