@@ -224,6 +224,7 @@ DepthStageResult RunDepthStage(const Scene& scene,
         Msg(prefix, ": ", valid, " samples (", map.width(), "x", map.height(),
             ", ", static_cast<int>(fill + 0.5), "% filled), ",
             report.seeds_accepted, "/", report.seeds_tried, " seeds, ",
+            report.planar_samples, " from planes, ",
             Progress::FormatDuration(report.seconds));
     for (const std::string& f : report.fallbacks) note += "\n    " + f;
     progress.End(note);

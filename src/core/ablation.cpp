@@ -28,6 +28,9 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry->Add(key("consistency"), &o->consistency,
                 "filter the finished depth maps against their neighbours' "
                 "(mvs.consistency); false = keep every sample (paper)");
+  registry->Add(key("planar_prior"), &o->planar_prior,
+                "fill where growth stopped from the planes of triangles of "
+                "confident samples; false = growth alone (paper)");
 }
 
 }  // namespace wild_mvs

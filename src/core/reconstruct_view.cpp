@@ -10,6 +10,7 @@
 #include <unordered_set>
 
 #include "wild_mvs/core/error.h"
+#include "wild_mvs/core/planar_prior.h"
 
 namespace wild_mvs {
 
@@ -41,6 +42,7 @@ MvsOptions PaperMvsOptions() {
   o.sweep.below_seeds = 0;
   o.ablation.photometric_offset = false;
   o.ablation.consistency = false;
+  o.ablation.planar_prior = false;
   return o;
 }
 
@@ -190,6 +192,7 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
       seeds.push_back(Seed{x, y, cam.Depth(X)});
     };
     for (int p : ppv[ref]) add_point(p);
+    const std::vector<Seed> own_points = seeds;  // R sees them
     for (int v : sel.neighbors)
       for (int p : ppv[v]) add_point(p);
 
@@ -231,6 +234,14 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
       if (!swept.empty())
         GrowRegions(ctx, mpgc, local, options.growing, swept, wmask, pool,
                     &dm.depth, &dm.normal, &dm.confidence, &stats, cancel);
+    }
+    // 4. Planar prior where growth stopped (planar_prior.h).
+    if (options.ablation.planar_prior && !(cancel && cancel->load())) {
+      PlanarPriorStats planar;
+      FillFromPlanarPrior(ctx, mpgc, local, own_points, wmask, pool, &dm,
+                          &planar);
+      body_cpu += planar.cpu_seconds;
+      rep.planar_samples = planar.samples_added;
     }
     rep.seeds_tried = stats.seeds_tried;
     rep.seeds_accepted = stats.seeds_accepted;

@@ -67,6 +67,7 @@ std::string ViewReportJson(const ViewReport& r, const Scene& scene) {
      << ",\n  \"seeds_tried\": " << r.seeds_tried
      << ",\n  \"seeds_accepted\": " << r.seeds_accepted
      << ",\n  \"samples\": " << r.samples
+     << ",\n  \"planar_samples\": " << r.planar_samples
      << ",\n  \"pixel_visits\": " << r.pixel_visits << ",\n  \"fallbacks\": [";
   for (size_t i = 0; i < r.fallbacks.size(); ++i)
     os << (i ? ", " : "") << "\"" << JsonEscape(r.fallbacks[i]) << "\"";
