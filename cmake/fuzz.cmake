@@ -10,8 +10,9 @@
 # test/fuzz/fuzz_<name>.cpp becomes an executable fuzz_<name> (a libFuzzer
 # binary; run it with a corpus folder, see scripts/run_fuzz.sh). With
 # WILD_MVS_WITH_ROS=ON, test/fuzz/ros/fuzz_ros_messages.cpp (the nodes'
-# message decoding, src/ros/conversions.cpp) is built too. The target
-# `fuzzers` builds all harnesses into ${CMAKE_BINARY_DIR}/fuzz/.
+# message decoding, src/ros/conversions.cpp over src/io/pixel_buffer.cpp) is
+# built too. The target `fuzzers` builds all harnesses into
+# ${CMAKE_BINARY_DIR}/fuzz/.
 if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
   message(FATAL_ERROR "WILD_MVS_FUZZ=ON needs clang "
           "(-DCMAKE_CXX_COMPILER=clang++); got ${CMAKE_CXX_COMPILER_ID}")

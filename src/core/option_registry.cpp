@@ -327,6 +327,14 @@ OptionRegistry::Option& OptionRegistry::Add(const std::string& key,
   return AddOption(key, Type::kString, field, help);
 }
 
+OptionRegistry::Option& OptionRegistry::Add(const Option& option) {
+  Require(!option.key_.empty() && !index_.count(option.key_),
+          "OptionRegistry: option '", option.key_, "' registered twice");
+  index_[option.key_] = options_.size();
+  options_.push_back(option);
+  return options_.back();
+}
+
 OptionRegistry::Option* OptionRegistry::Find(const std::string& key) {
   auto it = index_.find(key);
   return it == index_.end() ? nullptr : &options_[it->second];

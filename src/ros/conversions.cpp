@@ -8,11 +8,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/image.h"
+#include "wild_mvs/io/pixel_buffer.h"
 
 namespace wild_mvs {
 namespace ros1 {
@@ -24,32 +24,17 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 bool Finite(double v) { return std::isfinite(v); }
 
-// Largest image side accepted from a message (images and camera_info).
-constexpr uint32_t kMaxMsgImageSide = 32768;
-
-// Wraps msg.data as a cv::Mat of `type` after checking the layout.
-cv::Mat WrapImage(const sensor_msgs::Image& msg, int type,
-                  const std::string& what) {
-  Require(msg.width > 0 && msg.height > 0, what, ": empty image (", msg.width,
-          "x", msg.height, ")");
-  Require(msg.width <= kMaxMsgImageSide && msg.height <= kMaxMsgImageSide, what,
-          ": image of ", msg.width, "x", msg.height, " is too large");
-  const size_t row_bytes = static_cast<size_t>(msg.width) * CV_ELEM_SIZE(type);
-  Require(msg.step >= row_bytes, what, ": step ", msg.step,
-          " is shorter than a row of ", msg.width, " pixels of encoding '",
-          msg.encoding, "' (", row_bytes, " bytes)");
-  Require(msg.data.size() >= static_cast<size_t>(msg.step) * msg.height, what,
-          ": data has ", msg.data.size(), " bytes, step * height = ",
-          static_cast<size_t>(msg.step) * msg.height);
-  const int bytes_per_channel = CV_ELEM_SIZE1(type);
-  const bool host_big_endian = false;  // x86 / ARM little endian
-  Require(bytes_per_channel == 1 || bool(msg.is_bigendian) == host_big_endian,
-          what, ": big-endian ", msg.encoding, " data is not supported");
-  Require(msg.step % bytes_per_channel == 0, what, ": step ", msg.step,
-          " is not a multiple of the channel size");
-  // const_cast: the Mat is only read (and cloned before it is kept).
-  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width),
-                 type, const_cast<uint8_t*>(msg.data.data()), msg.step);
+// The pixels of an image message (not copied).
+PixelBuffer BufferOf(const sensor_msgs::Image& msg) {
+  PixelBuffer b;
+  b.width = msg.width;
+  b.height = msg.height;
+  b.encoding = msg.encoding;
+  b.big_endian = msg.is_bigendian != 0;
+  b.step = msg.step;
+  b.data = msg.data.data();
+  b.size = msg.data.size();
+  return b;
 }
 
 }  // namespace
@@ -75,9 +60,10 @@ void CameraFromCameraInfo(const sensor_msgs::CameraInfo& info, Camera* camera,
   Require(info.width > 0 && info.height > 0, "camera_info: image size is ",
           info.width, "x", info.height);
   // Larger sizes would also overflow Camera's int width/height.
-  Require(info.width <= kMaxMsgImageSide && info.height <= kMaxMsgImageSide,
-          "camera_info: image size ", info.width, "x", info.height,
-          " is too large (at most ", kMaxMsgImageSide, " per side)");
+  Require(
+      info.width <= kMaxBufferImageSide && info.height <= kMaxBufferImageSide,
+      "camera_info: image size ", info.width, "x", info.height,
+      " is too large (at most ", kMaxBufferImageSide, " per side)");
   double fx, fy, cx_ros, cy_ros;
   if (rectified) {
     for (double v : P)
@@ -237,85 +223,13 @@ geometry_msgs::Pose PoseFromCamera(const Camera& camera) {
 }
 
 cv::Mat ImageToLinearRgb(const sensor_msgs::Image& msg, bool linearize) {
-  const std::string& e = msg.encoding;
-  const std::string what = "image (encoding '" + e + "')";
-  cv::Mat m;
-  if (e == enc::MONO8) {
-    m = WrapImage(msg, CV_8UC1, what);
-  } else if (e == enc::MONO16) {
-    m = WrapImage(msg, CV_16UC1, what);
-  } else if (e == enc::BGR8 || e == enc::RGB8) {
-    m = WrapImage(msg, CV_8UC3, what);
-  } else if (e == enc::BGR16 || e == enc::RGB16) {
-    m = WrapImage(msg, CV_16UC3, what);
-  } else if (e == enc::BGRA8 || e == enc::RGBA8) {
-    m = WrapImage(msg, CV_8UC4, what);
-  } else if (e == enc::TYPE_32FC1) {
-    m = WrapImage(msg, CV_32FC1, what);
-  } else if (e == enc::BAYER_RGGB8 || e == enc::BAYER_BGGR8 ||
-             e == enc::BAYER_GBRG8 || e == enc::BAYER_GRBG8 ||
-             e == enc::BAYER_RGGB16 || e == enc::BAYER_BGGR16 ||
-             e == enc::BAYER_GBRG16 || e == enc::BAYER_GRBG16) {
-    const bool is16 = enc::bitDepth(e) == 16;
-    cv::Mat raw = WrapImage(msg, is16 ? CV_16UC1 : CV_8UC1, what);
-    Require(raw.cols >= 2 && raw.rows >= 2, what,
-            ": a Bayer image needs at least 2x2 pixels");
-    // OpenCV names a Bayer pattern by the 2x2 block starting at pixel (1, 1)
-    // (its second row and column), ROS by the one at (0, 0): image_proc's
-    // mapping (rggb -> BayerBG, bggr -> BayerRG, gbrg -> BayerGR, grbg ->
-    // BayerGB). Checked by the Conversions.BayerDemosaic test.
-    int code;
-    if (e == enc::BAYER_RGGB8 || e == enc::BAYER_RGGB16) {
-      code = cv::COLOR_BayerBG2BGR;
-    } else if (e == enc::BAYER_BGGR8 || e == enc::BAYER_BGGR16) {
-      code = cv::COLOR_BayerRG2BGR;
-    } else if (e == enc::BAYER_GBRG8 || e == enc::BAYER_GBRG16) {
-      code = cv::COLOR_BayerGR2BGR;
-    } else {
-      code = cv::COLOR_BayerGB2BGR;
-    }
-    cv::cvtColor(raw, m, code);  // BGR, a new buffer
-  } else if (e == enc::TYPE_32FC3) {
-    m = WrapImage(msg, CV_32FC3, what);
-  } else {
-    throw Error(Msg("image: unsupported encoding '", e,
-                    "' (expected mono8, mono16, rgb8, bgr8, rgba8, bgra8, "
-                    "rgb16, bgr16, 32FC1, 32FC3, bayer_rggb8, bayer_bggr8, "
-                    "bayer_gbrg8, bayer_grbg8 or their 16-bit variants)"));
-  }
-  // ToLinearRgb expects OpenCV's BGR(A) order.
-  cv::Mat bgr;
-  if (e == enc::RGB8 || e == enc::RGB16 || e == enc::TYPE_32FC3) {
-    cv::cvtColor(m, bgr, cv::COLOR_RGB2BGR);
-  } else if (e == enc::RGBA8) {
-    cv::cvtColor(m, bgr, cv::COLOR_RGBA2BGR);
-  } else {
-    bgr = m;
-  }
-  const bool is_float = m.depth() == CV_32F;
-  if (is_float) {
-    Require(cv::checkRange(bgr, true, nullptr, -1e6, 1e6), what,
-            ": non-finite pixel values");
-  }
-  cv::Mat out = ToLinearRgb(bgr, linearize && !is_float);
-  if (out.data == msg.data.data()) out = out.clone();  // never alias the msg
-  return out;
+  return PixelsToLinearRgb(BufferOf(msg), linearize);
 }
 
 cv::Mat CompressedToLinearRgb(const sensor_msgs::CompressedImage& msg,
                               bool linearize) {
-  Require(!msg.data.empty(), "compressed image: no data (format '", msg.format,
-          "')");
-  cv::Mat bgr;
-  try {
-    bgr = cv::imdecode(msg.data, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw Error(Msg("compressed image (format '", msg.format,
-                    "'): cannot decode: ", e.what()));
-  }
-  Require(!bgr.empty(), "compressed image (format '", msg.format,
-          "'): cannot decode ", msg.data.size(), " bytes");
-  return ToLinearRgb(bgr, linearize);
+  return DecodeToLinearRgb(msg.data.data(), msg.data.size(), msg.format,
+                           linearize);
 }
 
 cv::Mat FloatImageFromMsg(const sensor_msgs::Image& msg, int channels,
@@ -323,7 +237,7 @@ cv::Mat FloatImageFromMsg(const sensor_msgs::Image& msg, int channels,
   const std::string want = channels == 1 ? enc::TYPE_32FC1 : enc::TYPE_32FC3;
   Require(msg.encoding == want, what, ": encoding '", msg.encoding,
           "', expected '", want, "'");
-  return WrapImage(msg, CV_MAKETYPE(CV_32F, channels), what).clone();
+  return WrapPixels(BufferOf(msg), CV_MAKETYPE(CV_32F, channels), what).clone();
 }
 
 sensor_msgs::Image DepthToMsg(const cv::Mat& depth) {

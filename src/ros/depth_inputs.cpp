@@ -34,7 +34,7 @@ DepthInputs::DepthInputs(const ros::NodeHandle& nh,
     info_topic_ = image_transport::getCameraInfoTopic(image_topic_);
   rectified_ = options_.rectified || EndsWith(image_topic_, "/image_rect") ||
                EndsWith(image_topic_, "/image_rect_color");
-  undistorter_ = std::make_unique<Undistorter>(rectified_);
+  undistorter_ = std::make_unique<Undistorter>();
 }
 
 void DepthInputs::Subscribe(FrameFn on_frame, PointsFn on_points) {
@@ -285,9 +285,11 @@ bool DepthInputs::ConvertImage(const DepthFrame& f, Camera* cam,
     return false;
   }
   // Undistorted with maps built once per camera_info (a rectified
-  // input passes through: the camera is P's).
+  // input passes through: the camera is P's, without distortion).
   try {
-    *image = undistorter_->Apply(*f.info, *image, cam);
+    Distortion d;
+    CameraFromCameraInfo(*f.info, cam, &d, rectified_);
+    *image = undistorter_->Apply(*cam, d, *image);
   } catch (const Error& e) {
     drop_(info_topic_, "invalid camera_info", e.what());
     return false;

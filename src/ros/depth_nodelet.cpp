@@ -12,11 +12,11 @@
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/ros/bus_stats.h"
-#include "wild_mvs/ros/conversions.h"
 #include "wild_mvs/ros/depth_front_end.h"
 #include "wild_mvs/ros/depth_inputs.h"
 #include "wild_mvs/ros/depth_messages.h"
 #include "wild_mvs/ros/depth_worker_input.h"
+#include "wild_mvs/ros/diagnostics.h"
 #include "wild_mvs/ros/keyframe_link.h"
 #include "wild_mvs/ros/live_params.h"
 #include "wild_mvs/ros/params_ros.h"
@@ -59,16 +59,8 @@ struct DepthNode::Impl {
   // Counts and (throttled) reports one dropped input.
   void Drop(const std::string& topic, const std::string& problem,
             const std::string& detail = "") {
-    uint64_t n = 0;
-    const std::string reason = topic + ": " + problem;
-    if (drops.Count(reason, &n)) {
-      ROS_ERROR(
-          "%s: dropped: %s%s%s (%lu so far; throttled to one message "
-          "per %.0f s per problem)",
-          pnh.getNamespace().c_str(), reason.c_str(),
-          detail.empty() ? "" : ": ", detail.c_str(),
-          static_cast<unsigned long>(n), kErrorThrottle);
-    }
+    LogDrop(&drops, pnh.getNamespace(), topic + ": " + problem, detail,
+            kErrorThrottle);
   }
 
   // The topic frames come from: `image` (or its compressed topic), a

@@ -1,6 +1,8 @@
 // Copyright wild_mvs authors.
 #include "wild_mvs/ros/diagnostics.h"
 
+#include <ros/console.h>
+
 namespace wild_mvs {
 namespace ros1 {
 
@@ -29,6 +31,18 @@ void AddDropValues(const DropCounter& drops, const std::string& what,
   stat.add("drop window s", drops.window());
   for (const auto& [reason, n] : drops.Counts())
     stat.add("dropped: " + reason, n);
+}
+
+void LogDrop(DropCounter* drops, const std::string& ns,
+             const std::string& reason, const std::string& detail,
+             double throttle) {
+  uint64_t n = 0;
+  if (!drops->Count(reason, &n)) return;
+  ROS_ERROR(
+      "%s: dropped: %s%s%s (%lu so far; throttled to one message per %.0f s "
+      "per problem)",
+      ns.c_str(), reason.c_str(), detail.empty() ? "" : ": ", detail.c_str(),
+      static_cast<unsigned long>(n), throttle);
 }
 
 }  // namespace ros1

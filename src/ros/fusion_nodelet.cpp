@@ -20,7 +20,6 @@
 #include "wild_mvs/ros/fusion_messages.h"
 #include "wild_mvs/ros/fusion_outputs.h"
 #include "wild_mvs/ros/params_ros.h"
-#include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/fusion_session.h"
 #include "wild_mvs/stream/keyframe_ledger.h"
 #include "wild_mvs/stream/work_queue.h"
@@ -56,13 +55,8 @@ struct FusionNode::Impl {
   std::string Topic() const { return nh.resolveName("depth_view"); }
 
   void Drop(const std::string& problem, const std::string& detail = "") {
-    uint64_t n = 0;
-    const std::string reason = Topic() + ": " + problem;
-    if (drops.Count(reason, &n))
-      ROS_ERROR("%s: dropped: %s%s%s (%lu so far; throttled)",
-                pnh.getNamespace().c_str(), reason.c_str(),
-                detail.empty() ? "" : ": ", detail.c_str(),
-                static_cast<unsigned long>(n));
+    LogDrop(&drops, pnh.getNamespace(), Topic() + ": " + problem, detail,
+            options.error_throttle);
   }
 
   void OnView(const wild_mvs::DepthViewConstPtr& msg) {

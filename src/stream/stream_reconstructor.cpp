@@ -786,6 +786,19 @@ void StreamReconstructor::SetNextKeyframeId(uint32_t id) {
   next_id_ = std::max(next_id_, id);
 }
 
+const char* const kStreamCoreKeys[] = {"mvs.max_image_size",
+                                       "mvs.global.num_neighbors",
+                                       "mvs.local.num_active",
+                                       "mvs.local.min_ncc",
+                                       "mvs.mpgc.window",
+                                       "mvs.mpgc.drop_ncc",
+                                       "mvs.mpgc.min_active_views",
+                                       "mvs.growing.revisit_margin",
+                                       "mvs.sweep.below_seeds",
+                                       "consistency.min_consistent",
+                                       "tracker.features.max_features",
+                                       "tracker.min_track_length"};
+
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      StreamOptions* o) {
   auto key = [&prefix](const char* name) {
@@ -827,11 +840,15 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry
       ->Add(key("worker_count"), &o->worker_count, "number of depth workers")
       .Min(1);
-  // use_tracker follows the node's sparse_source.
-  RegisterOptions(registry, key("mvs"), &o->mvs);
+  // use_tracker follows the node's sparse_source. Of the core's options
+  // (the CLI's mvs.*, consistency.* and tracker.* keys) only those of
+  // kStreamCoreKeys are offered; the others keep the library defaults.
+  OptionRegistry core;
+  RegisterOptions(&core, key("mvs"), &o->mvs);
   // The revisions' consistency step: the CLI's consistency.* keys.
-  RegisterOptions(registry, key("consistency"), &o->mvs.consistency);
-  RegisterOptions(registry, key("tracker"), &o->tracker);
+  RegisterOptions(&core, key("consistency"), &o->mvs.consistency);
+  RegisterOptions(&core, key("tracker"), &o->tracker);
+  for (const char* k : kStreamCoreKeys) registry->Add(*core.Find(key(k)));
 }
 
 }  // namespace wild_mvs

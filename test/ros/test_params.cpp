@@ -2,9 +2,11 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <set>
 
 #include "option_ranges.h"
 #include "wild_mvs/core/error.h"
@@ -36,7 +38,7 @@ TEST(Params, ValuesReachTheCoreOptions) {
                     {"sparse_source", std::string("topic")},
                     {"mvs/global/num_neighbors", 6},
                     {"mvs/local/min_ncc", 0.35},
-                    {"mvs/mpgc/bilateral_sigma_color", 8.0},
+                    {"consistency/min_consistent", 2},
                     {"tracker/features/max_features", 1500},
                     {"max_keyframe_mb", 128.0},
                     {"mvs/mpgc/min_active_views", 2},
@@ -51,7 +53,7 @@ TEST(Params, ValuesReachTheCoreOptions) {
   EXPECT_FALSE(d.stream.use_tracker);
   EXPECT_EQ(d.stream.mvs.global.num_neighbors, 6);
   EXPECT_DOUBLE_EQ(d.stream.mvs.local.min_ncc, 0.35);
-  EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.bilateral_sigma_color, 8.0);
+  EXPECT_EQ(d.stream.mvs.consistency.min_consistent, 2);
   EXPECT_EQ(d.stream.tracker.features.max_features, 1500);
   EXPECT_DOUBLE_EQ(d.stream.store.max_mb, 128.0);
   EXPECT_EQ(d.stream.mvs.mpgc.min_active_views, 2);
@@ -105,6 +107,12 @@ MapParamSource ParamsFromYaml(const YAML::Node& root) {
   return out;
 }
 
+// "mvs/mpgc/window" -> "mvs.mpgc.window".
+std::string DottedKey(std::string name) {
+  std::replace(name.begin(), name.end(), '/', '.');
+  return name;
+}
+
 std::string Dir() { return std::string(WILD_MVS_SOURCE_DIR) + "/config/"; }
 
 // The config files list every parameter with its default (they are
@@ -135,16 +143,56 @@ TEST(Params, ConfigFilesLoadAsTheDefaults) {
   }
 }
 
-// The mvs: and tracker: sections of config/reconstruct.yaml (the CLI's keys)
-// are the depth node's mvs/ and tracker/ parameters, and fusion: the fusion
-// node's fusion/: a tuned section loads unchanged.
+// The depth node registers only the keys it reads, at most 40: its own, the
+// stream's and the core thresholds of kStreamCoreKeys.
+TEST(Params, DepthNodeKeys) {
+  DepthNodeOptions o;
+  OptionRegistry r;
+  RegisterOptions(&r, "", &o);
+  EXPECT_LE(r.options().size(), 40u);
+  for (const char* k : kStreamCoreKeys) EXPECT_TRUE(r.Has(k)) << k;
+  // Tuning knobs whose library default is right are not parameters.
+  for (const char* k :
+       {"mvs.mpgc.bilateral_sigma_color", "mvs.mpgc.explain_margin",
+        "mvs.mpgc.wide_drop_ncc", "mvs.local.wide_min_ncc",
+        "mvs.mpgc.window_step", "consistency.max_relative_depth",
+        "tracker.features.downscale", "tracker.features.max_image_size",
+        "tracker.scene_depth", "tracker.max_neighbors"})
+    EXPECT_FALSE(r.Has(k)) << k;
+}
+
+// The core options of the depth node (registry over `d`'s fields) and of
+// the CLI (over `mvs` and `tracker`) under the CLI's keys.
+void RegisterCoreOptions(DepthNodeOptions* d, OptionRegistry* r) {
+  RegisterOptions(r, "mvs", &d->stream.mvs);
+  RegisterOptions(r, "consistency", &d->stream.mvs.consistency);
+  RegisterOptions(r, "tracker", &d->stream.tracker);
+}
+
+// The mvs:, consistency: and tracker: sections of config/reconstruct.yaml
+// (the CLI's keys) are the depth node's mvs/, consistency/ and tracker/
+// parameters where the node reads them, and fusion: the fusion node's
+// fusion/: a tuned section loads unchanged; the keys the node does not read
+// are listed as unknown (warned about) and keep the library default.
 TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
   const YAML::Node all = YAML::LoadFile(Dir() + "reconstruct.yaml");
-  for (const char* section : {"mvs", "tracker"}) {
+  DepthNodeOptions defaults;
+  OptionRegistry node_keys;
+  RegisterOptions(&node_keys, "", &defaults);
+  for (const char* section : {"mvs", "consistency", "tracker"}) {
     YAML::Node only;
     only[section] = all[section];
-    EXPECT_TRUE(UnknownDepthNodeParams(ParamsFromYaml(only)).empty())
-        << section;
+    const MapParamSource params = ParamsFromYaml(only);
+    std::set<std::string> unknown;
+    for (const std::string& n : UnknownDepthNodeParams(params))
+      unknown.insert(n);
+    int known = 0;
+    for (const std::string& n : params.Names()) {
+      const bool read = node_keys.Find(DottedKey(n)) != nullptr;
+      known += read;
+      EXPECT_NE(read, unknown.count(n) > 0) << n;
+    }
+    EXPECT_GE(known, 1) << section;
   }
   YAML::Node fusion;
   fusion["fusion"] = all["fusion"];
@@ -154,8 +202,10 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
       "mvs:\n"
       "  global: {num_neighbors: 6}\n"
       "  local: {num_active: 5, min_ncc: 0.25}\n"
-      "  mpgc: {window: 7, drop_ncc: 0.5, min_active_views: 2}\n"
+      "  mpgc: {window: 7, drop_ncc: 0.5, min_active_views: 2,\n"
+      "         bilateral_sigma_color: 8}\n"
       "  sweep: {below_seeds: 4}\n"
+      "consistency: {min_consistent: 2, max_relative_depth: 0.02}\n"
       "tracker:\n"
       "  features: {downscale: 2.0, max_features: 1234}\n"
       "  min_track_length: 3\n";
@@ -164,24 +214,44 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
   TrackerOptions tracker;
   OptionRegistry cli;
   RegisterOptions(&cli, "mvs", &mvs);
+  RegisterOptions(&cli, "consistency", &mvs.consistency);
   RegisterOptions(&cli, "tracker", &tracker);
   LoadOptionsYamlString(&cli, tuned, "tuned");
   // ... and the depth node's (rosparam load into its namespace).
-  const DepthNodeOptions d =
-      ReadDepthNodeOptions(ParamsFromYaml(YAML::Load(tuned)));
+  const MapParamSource params = ParamsFromYaml(YAML::Load(tuned));
+  const DepthNodeOptions d = ReadDepthNodeOptions(params);
   DepthNodeOptions node = d;
-  OptionRegistry r;
+  OptionRegistry r, core, library;
   RegisterOptions(&r, "", &node);
+  RegisterCoreOptions(&node, &core);
+  RegisterCoreOptions(&defaults, &library);
+  const std::vector<std::string> unknown = UnknownDepthNodeParams(params);
   for (const auto& o : cli.options()) {
-    const OptionRegistry::Option* n = r.Find(o.key());
-    ASSERT_NE(n, nullptr) << o.key() << " is not a depth node parameter";
-    EXPECT_EQ(n->Text(), o.Text()) << o.key();
+    if (r.Has(o.key())) {
+      EXPECT_EQ(r.Find(o.key())->Text(), o.Text()) << o.key();
+    } else {
+      // Not read: the library default, and named when it was set.
+      EXPECT_EQ(core.Find(o.key())->Text(), library.Find(o.key())->Text())
+          << o.key();
+      ParamSource::Value v;
+      EXPECT_EQ(
+          params.Lookup(ParamName(o.key()), &v),
+          std::count(unknown.begin(), unknown.end(), ParamName(o.key())) == 1)
+          << o.key();
+    }
   }
+  EXPECT_EQ(unknown.size(), 3u);  // downscale, bilateral, relative depth
   EXPECT_EQ(d.stream.mvs.mpgc.window, 7);
   EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.drop_ncc, 0.5);
   EXPECT_DOUBLE_EQ(d.stream.mvs.local.min_ncc, 0.25);
+  EXPECT_EQ(d.stream.mvs.local.num_active, 5);
   EXPECT_EQ(d.stream.mvs.sweep.below_seeds, 4);
-  EXPECT_DOUBLE_EQ(d.stream.tracker.features.downscale, 2.0);
+  EXPECT_EQ(d.stream.mvs.consistency.min_consistent, 2);
+  EXPECT_EQ(d.stream.tracker.features.max_features, 1234);
+  EXPECT_DOUBLE_EQ(d.stream.tracker.features.downscale,
+                   FeatureOptions().downscale);
+  EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.bilateral_sigma_color,
+                   MpgcOptions().bilateral_sigma_color);
 }
 
 TEST(Params, RangesAgreeWithCheck) {
@@ -264,6 +334,14 @@ TEST(Params, UnknownParametersAreListed) {
                                                    {"drop_window", 60.0},
                                                    {"repair_delay", 1.0},
                                                    {"max_image_size", 320}}))
+                .size(),
+            4u);
+  // Core options the node leaves at the library default.
+  EXPECT_EQ(UnknownDepthNodeParams(
+                MapParamSource({{"mvs/mpgc/explain_margin", 0.1},
+                                {"mvs/mpgc/window_step", 1},
+                                {"tracker/scene_depth", 3.0},
+                                {"consistency/free_space_margin", 0.02}}))
                 .size(),
             4u);
   EXPECT_TRUE(

@@ -52,6 +52,24 @@ TEST(OptionRegistry, StructNestingGivesTheKeys) {
   EXPECT_THROW(r.Add("run.threads", &c.run.threads, "again"), Error);
 }
 
+// A copy of another registry's option sets the same field and keeps its
+// help and range (a node offers a subset of a struct's options).
+TEST(OptionRegistry, AddCopiesAnOptionOfAnotherRegistry) {
+  MvsOptions m;
+  OptionRegistry all;
+  RegisterOptions(&all, "mvs", &m);
+  OptionRegistry some;
+  const OptionRegistry::Option& w = some.Add(*all.Find("mvs.mpgc.window"));
+  EXPECT_EQ(w.key(), "mvs.mpgc.window");
+  EXPECT_EQ(w.help(), all.Find("mvs.mpgc.window")->help());
+  EXPECT_EQ(w.RangeText(), all.Find("mvs.mpgc.window")->RangeText());
+  ASSERT_EQ(some.options().size(), 1u);
+  some.Find("mvs.mpgc.window")->SetInt(7);
+  EXPECT_EQ(m.mpgc.window, 7);
+  EXPECT_FALSE(some.Has("mvs.mpgc.drop_ncc"));
+  EXPECT_THROW(some.Add(*all.Find("mvs.mpgc.window")), Error);
+}
+
 TEST(OptionRegistry, ParsesByTypeOnly) {
   int i = 0;
   double d = 0, box = 0;

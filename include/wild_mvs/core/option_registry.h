@@ -124,6 +124,10 @@ class OptionRegistry {
               const std::string& help);
   Option& Add(const std::string& key, std::string* field,
               const std::string& help);
+  // Registers a copy of an option of another registry (the same key, field,
+  // help and range), to offer a subset of a struct's registered options.
+  // Throws Error when the key is registered already.
+  Option& Add(const Option& option);
 
   bool Has(const std::string& key) const { return index_.count(key) > 0; }
   // nullptr when the key is not registered.

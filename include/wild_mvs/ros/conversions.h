@@ -99,7 +99,8 @@ geometry_msgs::Pose PoseFromCamera(const Camera& camera);
 // big-endian multi-byte data, a step shorter than a row, and data shorter
 // than step * height.
 cv::Mat ImageToLinearRgb(const sensor_msgs::Image& msg, bool linearize);
-// A sensor_msgs/CompressedImage (JPEG / PNG) decoded with cv::imdecode.
+// A sensor_msgs/CompressedImage (JPEG / PNG) decoded with cv::imdecode
+// (both: io/pixel_buffer.h over the message fields).
 cv::Mat CompressedToLinearRgb(const sensor_msgs::CompressedImage& msg,
                               bool linearize);
 // A view of a 32FC1 / 32FC3 image message's data (validated; copied).

@@ -35,10 +35,10 @@
 
 #include "wild_mvs/core/camera.h"
 #include "wild_mvs/ros/params.h"
-#include "wild_mvs/ros/undistorter.h"
 #include "wild_mvs/stream/pose_track.h"
 #include "wild_mvs/stream/stamp_buffer.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
+#include "wild_mvs/stream/undistorter.h"
 
 namespace wild_mvs {
 namespace ros1 {

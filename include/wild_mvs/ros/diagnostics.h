@@ -36,5 +36,13 @@ class RateStatus : private std::pair<double, double>,
 void AddDropValues(const DropCounter& drops, const std::string& what,
                    diagnostic_updater::DiagnosticStatusWrapper& stat);
 
+// Counts one dropped input of `reason` ("<topic>: <problem>") in `drops`
+// and, when the counter lets it through (one message per reason per
+// `throttle` s), logs it with ROS_ERROR: "<ns>: dropped: <reason>: <detail>
+// (<n> so far; ...)".
+void LogDrop(DropCounter* drops, const std::string& ns,
+             const std::string& reason, const std::string& detail,
+             double throttle);
+
 }  // namespace ros1
 }  // namespace wild_mvs

@@ -9,7 +9,9 @@
 // ~get_keyframe. A worker takes every keyframe it receives (ownership is a
 // hash of the stamp, KeyframeOwner, so it needs no agreement with the other
 // workers on which frames they saw) and fetches what it missed: a gap in
-// the ids at once, a keyframe the index announced after repair_delay.
+// the ids at once, a keyframe the index announced after repair_delay
+// (KeyframeSequencer, stream/keyframe_sequencer.h, decides; this file
+// carries the messages and calls the service).
 #pragma once
 
 #include <ros/node_handle.h>
@@ -22,15 +24,15 @@
 #include <wild_mvs/SelectedKeyframe.h>
 
 #include <cstdint>
-#include <deque>
 #include <functional>
-#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "wild_mvs/core/camera.h"
 #include "wild_mvs/ros/depth_inputs.h"
+#include "wild_mvs/stream/keyframe_history.h"
+#include "wild_mvs/stream/keyframe_sequencer.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
 
 namespace wild_mvs {
@@ -59,12 +61,11 @@ class KeyframeAnnouncer {
 
   ros::NodeHandle pnh_;
   std::string world_frame_;
-  size_t history_size_;
   ros::Publisher keyframe_pub_, index_pub_;
   ros::ServiceServer get_srv_;
   mutable std::mutex mutex_;
   // The newest keyframes of the current session, consecutive ids.
-  std::deque<wild_mvs::SelectedKeyframeConstPtr> history_;
+  KeyframeHistory<wild_mvs::SelectedKeyframeConstPtr> history_;
   uint64_t published_ = 0, served_ = 0;
 };
 
@@ -104,20 +105,14 @@ class KeyframeReceiver {
 
  private:
   void Take(const wild_mvs::SelectedKeyframeConstPtr& msg);
-  // Fetches keyframes [next_id_, end) of `session`, in order.
-  void Fetch(uint64_t session_ns, uint32_t end);
+  // Fetches keyframes [next_id, end) of the sequencer's session, in order.
+  void Fetch(uint32_t end);
 
   ros::NodeHandle nh_;
-  double repair_delay_;
+  KeyframeSequencer sequencer_;  // what to take, skip and fetch
   ProcessFn process_;
   DropFn drop_;
   ros::ServiceClient get_client_;
-  bool have_session_ = false;
-  uint64_t session_ns_ = 0;
-  uint32_t next_id_ = 0;  // the next keyframe id expected
-  // First announcement (steady s) of keyframes listed by the index but not
-  // arrived, by (session, id).
-  std::map<std::pair<uint64_t, uint32_t>, double> announced_;
   mutable std::mutex stats_mutex_;
   Stats stats_;
 };

@@ -210,7 +210,8 @@ struct FusionNodeOptions {
 // The nodes' option structs in the registry. The depth node's own options
 // and its StreamOptions are top-level parameters (world_frame, num_threads,
 // keyframe_min_baseline, ...); StreamOptions::mvs and ::tracker are the
-// sections mvs/ and tracker/, FusionNodeOptions::session.fusion is fusion/,
+// sections mvs/, consistency/ and tracker/ with the core keys the node reads
+// (kStreamCoreKeys), FusionNodeOptions::session.fusion is fusion/,
 // with the core's keys (mvs/mpgc/drop_ncc). `prefix` is "" for a node.
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      DepthNodeOptions* options);

@@ -96,7 +96,14 @@ struct StreamOptions {
 };
 // Registers the fields under `prefix` (option_registry.h); the depth node
 // uses prefix "" (num_threads, ..., mvs/..., tracker/...). max_image_size
-// and the fields the node's role sets are not registered.
+// and the fields the node's role sets are not registered. Of the core's
+// options (mvs, its consistency, tracker) only kStreamCoreKeys are: the
+// thresholds a robot's user tunes (the CLI's keys of the same name). The
+// others (the wide-window thresholds, the one-view-occluder test, the
+// bilateral weights, the consistency tolerances, the tracker's geometry
+// and its feature image size, which mvs.max_image_size decides for a
+// stream) keep the library defaults.
+extern const char* const kStreamCoreKeys[12];
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      StreamOptions* options);
 

@@ -1,5 +1,6 @@
 // Copyright wild_mvs authors. libFuzzer harness: the ROS nodes' message
-// decoding path (src/ros/conversions.cpp), built only when ROS is found.
+// decoding path (src/ros/conversions.cpp over src/io/pixel_buffer.cpp),
+// built only when ROS is found.
 //
 // The message fields are read from the fuzz input in a simple little-endian
 // layout (not the ROS wire format, whose deserializer belongs to roscpp):

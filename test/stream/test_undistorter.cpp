@@ -1,5 +1,5 @@
 // Copyright wild_mvs authors. Undistorter: map caching, pass-through and
-// recovery of a synthetically distorted image.
+// recovery of a synthetically distorted image (no ROS).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,101 +7,97 @@
 #include <vector>
 
 #include "wild_mvs/core/error.h"
-#include "wild_mvs/core/scene.h"
-#include "wild_mvs/ros/conversions.h"
-#include "wild_mvs/ros/undistorter.h"
+#include "wild_mvs/stream/undistorter.h"
 
 namespace wild_mvs {
-namespace ros1 {
 namespace {
 
-sensor_msgs::CameraInfo MakeInfo(int w, int h, double f, double cx, double cy,
-                                 std::vector<double> D) {
-  sensor_msgs::CameraInfo info;
-  info.width = w;
-  info.height = h;
-  info.K = {f, 0, cx, 0, f, cy, 0, 0, 1};
-  info.P = {f, 0, cx, 0, 0, f, cy, 0, 0, 0, 1, 0};
-  info.distortion_model = "plumb_bob";
-  info.D = std::move(D);
-  return info;
+// A camera as CameraFromCameraInfo makes it (core pixel centres: cx = ROS
+// K[2] + 0.5).
+Camera MakeCamera(int w, int h, double f, double cx, double cy) {
+  Camera c;
+  c.width = w;
+  c.height = h;
+  c.fx = c.fy = f;
+  c.cx = cx;
+  c.cy = cy;
+  return c;
 }
 
-const std::vector<double> kD = {-0.2, 0.05, 0.001, -0.0005, 0.0};
+Distortion MakeDistortion(double k1, double k2, double p1, double p2,
+                          double k3) {
+  Distortion d;
+  d.model = Distortion::Model::kOpenCV;
+  d.k1 = k1;
+  d.k2 = k2;
+  d.p1 = p1;
+  d.p2 = p2;
+  d.k3 = k3;
+  return d;
+}
 
-// The undistorted scene: a smooth pattern in ROS pixel coordinates.
+const Distortion kD = MakeDistortion(-0.2, 0.05, 0.001, -0.0005, 0.0);
+
+// The undistorted scene: a smooth pattern in OpenCV pixel coordinates.
 float Pattern(double x, double y) {
   return static_cast<float>(0.5 + 0.2 * std::sin(x / 9) +
                             0.2 * std::cos(y / 11));
 }
 
-TEST(Undistorter, BuildsMapsOncePerCameraInfo) {
-  auto info = MakeInfo(160, 120, 150, 79.5, 59.5, kD);
+TEST(Undistorter, BuildsMapsOncePerCamera) {
+  Camera cam = MakeCamera(160, 120, 150, 80, 60);
+  Distortion d = kD;
   cv::Mat image(120, 160, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
   Undistorter u;
-  Camera cam;
   for (int i = 0; i < 50; ++i) {
-    info.header.seq = i;  // the header does not matter
-    cv::Mat out = u.Apply(info, image, &cam);
+    cam.t = Eigen::Vector3d(i, 0, 0);  // the pose does not matter
+    cv::Mat out = u.Apply(cam, d, image);
     ASSERT_EQ(out.size(), image.size());
     ASSERT_NE(out.data, image.data);
   }
   EXPECT_EQ(u.maps_built(), 1u);
-  info.K[0] = 151;  // K changes: a new map
-  u.Apply(info, image, &cam);
-  u.Apply(info, image, &cam);
+  cam.fx = 151;  // the intrinsics change: a new map
+  u.Apply(cam, d, image);
+  u.Apply(cam, d, image);
   EXPECT_EQ(u.maps_built(), 2u);
-  EXPECT_DOUBLE_EQ(cam.fx, 151.0);
-  info.D[0] = -0.21;  // D changes
-  u.Apply(info, image, &cam);
+  d.k1 = -0.21;  // the distortion changes
+  u.Apply(cam, d, image);
   EXPECT_EQ(u.maps_built(), 3u);
-  info.binning_x = info.binning_y = 2;  // binning changes (and the size)
-  cv::Mat half(60, 80, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
-  cv::Mat out = u.Apply(info, half, &cam);
+  // A binned camera (half the size, as CameraFromCameraInfo gives it).
+  Camera half = MakeCamera(80, 60, 75.5, 40, 30);
+  cv::Mat small(60, 80, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
+  cv::Mat out = u.Apply(half, d, small);
   EXPECT_EQ(u.maps_built(), 4u);
-  EXPECT_EQ(out.size(), half.size());
-  EXPECT_EQ(cam.width, 80);
-  info.roi.x_offset = 20;  // roi changes
-  info.roi.width = 100;
-  cv::Mat roi(60, 50, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
-  u.Apply(info, roi, &cam);
+  EXPECT_EQ(out.size(), small.size());
+  half.cx = 30;  // a region of interest moves the principal point
+  u.Apply(half, d, small);
   EXPECT_EQ(u.maps_built(), 5u);
-  EXPECT_EQ(cam.width, 50);
-  // An image of the wrong size for the info is an Error.
-  EXPECT_THROW(u.Apply(info, image, &cam), Error);
+  // An image of the wrong size for the camera is an Error, so is none.
+  EXPECT_THROW(u.Apply(half, d, image), Error);
+  EXPECT_THROW(u.Apply(half, d, cv::Mat()), Error);
 }
 
 TEST(Undistorter, NoDistortionIsPassThrough) {
   cv::Mat image(120, 160, CV_8UC3, cv::Scalar(1, 2, 3));
-  Camera cam;
-  for (const std::vector<double>& D :
-       {std::vector<double>(5, 0.0), std::vector<double>()}) {
+  const Camera cam = MakeCamera(160, 120, 150, 80, 60);
+  for (const Distortion& d : {MakeDistortion(0, 0, 0, 0, 0), Distortion(), [] {
+                                Distortion none =
+                                    kD;  // a rectified camera: kNone
+                                none.model = Distortion::Model::kNone;
+                                return none;
+                              }()}) {
     Undistorter u;
-    auto info = MakeInfo(160, 120, 150, 79.5, 59.5, D);
-    cv::Mat out = u.Apply(info, image, &cam);
+    cv::Mat out = u.Apply(cam, d, image);
     EXPECT_EQ(out.data, image.data);  // no remap
     EXPECT_EQ(u.maps_built(), 0u);
-    EXPECT_DOUBLE_EQ(cam.fx, 150.0);
-    EXPECT_DOUBLE_EQ(cam.cx, 80.0);
   }
-  // Rectified mode ignores D and takes the camera from P.
-  Undistorter rect(true);
-  auto info = MakeInfo(160, 120, 150, 79.5, 59.5, kD);
-  info.P[0] = 140;
-  cv::Mat out = rect.Apply(info, image, &cam);
-  EXPECT_EQ(out.data, image.data);
-  EXPECT_EQ(rect.maps_built(), 0u);
-  EXPECT_DOUBLE_EQ(cam.fx, 140.0);
 }
 
-// Renders the distorted image of Pattern for `info` (each distorted pixel
-// takes the pattern's value at its undistorted position, found with
-// iterative cv::undistortPoints and checked with cv::projectPoints), undistorts
-// it and compares with Pattern away from the border.
-void CheckRecovers(const sensor_msgs::CameraInfo& info) {
-  Camera cam;
-  Distortion d;
-  CameraFromCameraInfo(info, &cam, &d);
+// Renders the distorted image of Pattern for `cam` and `d` (each distorted
+// pixel takes the pattern's value at its undistorted position, found with
+// iterative cv::undistortPoints and checked with cv::projectPoints),
+// undistorts it and compares with Pattern away from the border.
+void CheckRecovers(const Camera& cam, const Distortion& d) {
   const cv::Matx33d K(cam.fx, 0, cam.cx - 0.5, 0, cam.fy, cam.cy - 0.5, 0, 0,
                       1);
   const std::vector<double> D = {d.k1, d.k2, d.p1, d.p2, d.k3};
@@ -130,11 +126,8 @@ void CheckRecovers(const sensor_msgs::CameraInfo& info) {
     }
   }
   Undistorter u;
-  Camera out_cam;
-  cv::Mat out = u.Apply(info, image, &out_cam);
+  cv::Mat out = u.Apply(cam, d, image);
   EXPECT_EQ(u.maps_built(), 1u);
-  EXPECT_DOUBLE_EQ(out_cam.fx, cam.fx);
-  EXPECT_DOUBLE_EQ(out_cam.cx, cam.cx);
   ASSERT_EQ(out.type(), CV_32FC1);
   const int border = cam.width / 8;
   double sum = 0, worst = 0;
@@ -158,19 +151,15 @@ void CheckRecovers(const sensor_msgs::CameraInfo& info) {
 }
 
 TEST(Undistorter, RecoversSyntheticallyDistortedImage) {
-  CheckRecovers(MakeInfo(320, 240, 300, 161.3, 118.2, kD));
+  // ROS K: f 300, principal point (161.3, 118.2).
+  CheckRecovers(MakeCamera(320, 240, 300, 161.8, 118.7), kD);
 }
 
 TEST(Undistorter, RecoversWithBinningAndRoi) {
-  auto info = MakeInfo(640, 480, 600, 322.6, 236.4, kD);
-  info.binning_x = info.binning_y = 2;
-  info.roi.x_offset = 40;
-  info.roi.y_offset = 20;
-  info.roi.width = 560;
-  info.roi.height = 440;
-  CheckRecovers(info);
+  // A 640x480 sensor (ROS K: f 600, (322.6, 236.4)) binned 2x2 with the roi
+  // x 40, y 20, 560x440: 280x220, f 300, cx (322.6 + 0.5 - 40) / 2.
+  CheckRecovers(MakeCamera(280, 220, 300, 141.55, 108.45), kD);
 }
 
 }  // namespace
-}  // namespace ros1
 }  // namespace wild_mvs
