@@ -150,10 +150,13 @@ TEST(PlanarPrior, FillsAWeaklyTexturedWallWhereNoWindowMatches) {
   EXPECT_GT(sc.filled, 0.33 * sc.surface) << sc.filled << " of " << sc.surface;
   EXPECT_GT(sc.within_1pct, 0.99 * sc.filled);
   // The known samples stay as they were.
-  for (int y = 0; y < in.height(); ++y)
-    for (int x = 0; x < in.width(); ++x)
-      if (in.depth.at<float>(y, x) > 0)
+  for (int y = 0; y < in.height(); ++y) {
+    for (int x = 0; x < in.width(); ++x) {
+      if (in.depth.at<float>(y, x) > 0) {
         ASSERT_EQ(out.depth.at<float>(y, x), in.depth.at<float>(y, x));
+      }
+    }
+  }
 }
 
 TEST(PlanarPrior, KeepsNoTriangleAcrossADepthEdge) {
