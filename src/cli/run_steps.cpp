@@ -220,12 +220,11 @@ DepthStageResult RunDepthStage(const Scene& scene,
     }
     const double fill =
         map.empty() ? 0.0 : 100.0 * valid / (map.width() * map.height());
-    std::string note =
-        Msg(prefix, ": ", valid, " samples (", map.width(), "x", map.height(),
-            ", ", static_cast<int>(fill + 0.5), "% filled), ",
-            report.seeds_accepted, "/", report.seeds_tried, " seeds, ",
-            report.planar_samples, " from planes, ",
-            Progress::FormatDuration(report.seconds));
+    std::string note = Msg(
+        prefix, ": ", valid, " samples (", map.width(), "x", map.height(), ", ",
+        static_cast<int>(fill + 0.5), "% filled), ", report.seeds_accepted, "/",
+        report.seeds_tried, " seeds, ", report.planar_samples, " from planes, ",
+        Progress::FormatDuration(report.seconds));
     for (const std::string& f : report.fallbacks) note += "\n    " + f;
     progress.End(note);
   }

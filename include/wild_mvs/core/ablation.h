@@ -19,7 +19,7 @@ struct AblationOptions {
   bool optimize_normal = true;       // false = fronto-parallel patches
   bool optimize_color_scale = true;  // false = colour scales fixed to 1
   bool photometric_offset = true;    // I_R = c I_V + b; false = c I_V (paper)
-  bool consistency = true;  // filter of the finished maps (beyond paper)
+  bool consistency = true;   // filter of the finished maps (beyond paper)
   bool planar_prior = true;  // fill from triangle planes (beyond paper)
 };
 
