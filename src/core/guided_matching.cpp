@@ -12,8 +12,7 @@ namespace wild_mvs {
 namespace sparse_internal {
 
 std::vector<Match> GuidedMatches(const Camera& ca, const Features& fa,
-                                 const Camera& cb, const Features& fb,
-                                 const TrackerOptions& opt) {
+                                 const Camera& cb, const Features& fb) {
   const int na = fa.size(), nb = fb.size();
   std::vector<Match> out;
   if (na == 0 || nb == 0) return out;

@@ -114,7 +114,6 @@ class RegionGrower {
                const std::atomic<bool>* cancel)
       : cancel_(cancel),
         cam_(context.ref_camera),
-        opt_(options),
         matchers_(context, mpgc, local),
         W_(context.ref_image.width),
         H_(context.ref_image.height),
@@ -125,15 +124,7 @@ class RegionGrower {
         outbox_(ntx_ * nty_),
         visits_(ntx_ * nty_, 0),
         // Given in NCC units; confidence = (NCC + 1) / 2.
-        margin_(static_cast<float>(0.5 * options.revisit_margin)),
-        min_score_(mpgc.drop_ncc),
-        // A held sample's explain verdict is not stored with the map: with
-        // the explain test keeping unexplained matches, only held samples
-        // above its gate (never tested) expand.
-        held_expand_conf_(
-            mpgc.explain_margin >= 0 && mpgc.explain_keeps_match
-                ? static_cast<float>(0.5 * (mpgc.explain_below_ncc + 1))
-                : 0.0f) {
+        margin_(static_cast<float>(0.5 * options.revisit_margin)) {
     if (!mask.empty()) mask_ = mask.isContinuous() ? mask : mask.clone();
     mmap_ = mask_.empty() ? nullptr : mask_.ptr<uint8_t>();
     dmap_ = depth->ptr<float>();
@@ -153,7 +144,6 @@ class RegionGrower {
         const Seed& s = seeds[i];
         if (s.x < 0 || s.y < 0 || s.x >= W_ || s.y >= H_) continue;
         if (mmap_ && !mmap_[s.y * W_ + s.x]) continue;
-        if (s.held) continue;  // expanded below, never matched
         if (!probe->WindowInside(s.x, s.y) || !(s.depth > 0)) continue;
         ok[i] = 1;
         ++stats_.seeds_tried;
@@ -168,48 +158,12 @@ class RegionGrower {
           std::min(seeds.size(), static_cast<size_t>(ci + 1) * chunk);
       for (size_t i = static_cast<size_t>(ci) * chunk; i < end; ++i) {
         if (ok[i] &&
-            !m->Match(seeds[i].x, seeds[i].y, seeds[i].depth,
-                      seeds[i].normal.isZero() ? fronto : seeds[i].normal,
-                      &res[i]))
+            !m->Match(seeds[i].x, seeds[i].y, seeds[i].depth, fronto, &res[i]))
           ok[i] = 0;
       }
       matchers_.Release(std::move(m));
     });
     stats_.pixel_visits += stats_.seeds_tried;
-    // Held samples: their empty 4-neighbours are queued (seed order, so
-    // deterministic), as GrowTile does after a match.
-    {
-      auto probe = matchers_.Acquire();
-      for (const Seed& s : seeds) {
-        if (!s.held || s.x < 0 || s.y < 0 || s.x >= W_ || s.y >= H_) continue;
-        const int p = s.y * W_ + s.x;
-        if (!(cmap_[p] > 0) || !(dmap_[p] > 0)) continue;
-        if (cmap_[p] < held_expand_conf_) continue;
-        ++stats_.held_seeds;
-        const Eigen::Vector3d n(nmap_[3 * p], nmap_[3 * p + 1],
-                                nmap_[3 * p + 2]);
-        const Eigen::Vector3d X0 = cam_.BackprojectCam(
-            Eigen::Vector2d(s.x + 0.5, s.y + 0.5), dmap_[p]);
-        static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
-        for (int k = 0; k < 4; ++k) {
-          const int nx = s.x + dx[k], ny = s.y + dy[k];
-          if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) continue;
-          const int np = ny * W_ + nx;
-          if (!WorthVisit(np, cmap_[p])) continue;
-          if (mmap_ && !mmap_[np]) continue;
-          if (!probe->WindowInside(nx, ny)) continue;
-          Candidate nc;
-          nc.conf = cmap_[p];
-          nc.pixel = np;
-          nc.depth =
-              static_cast<float>(PlaneDepthAt(cam_, nx, ny, X0, n, dmap_[p]));
-          if (!(nc.depth > 0) || !std::isfinite(nc.depth)) continue;
-          for (int j = 0; j < 3; ++j) nc.normal[j] = static_cast<float>(n[j]);
-          Push(&queues_[TileOf(nx, ny)], nc);
-        }
-      }
-      matchers_.Release(std::move(probe));
-    }
     for (size_t i = 0; i < seeds.size(); ++i) {
       if (!ok[i]) continue;
       ++stats_.seeds_accepted;
@@ -343,15 +297,11 @@ class RegionGrower {
 
   const std::atomic<bool>* cancel_;  // null = never
   const Camera& cam_;
-  const RegionGrowingOptions& opt_;
   MatcherPool matchers_;
   const int W_, H_, T_, ntx_, nty_;
   std::vector<std::vector<Candidate>> queues_, outbox_;
   std::vector<long long> visits_;
   const float margin_;
-  const double min_score_;
-  // Confidence below which a held sample does not expand.
-  const float held_expand_conf_;
   cv::Mat mask_;
   const uint8_t* mmap_ = nullptr;
   float* dmap_ = nullptr;
@@ -396,7 +346,6 @@ void GrowRegions(const PatchContext& context, const MpgcOptions& mpgc,
     stats->seeds_accepted += st.seeds_accepted;
     stats->pixel_visits += st.pixel_visits;
     stats->phases += st.phases;
-    stats->held_seeds += st.held_seeds;
     stats->cpu_seconds += st.cpu_seconds;
   }
 }

@@ -122,8 +122,8 @@ void SparseTracker::AddView(int view_index, const Camera& camera,
   std::vector<std::vector<sparse_internal::Match>> matches(nb.size());
   auto run = [&](int k) {
     const ViewData& old = m.views[nb[k]];
-    matches[k] = sparse_internal::GuidedMatches(
-        v.camera, v.features, old.camera, old.features, m.opt);
+    matches[k] = sparse_internal::GuidedMatches(v.camera, v.features,
+                                                old.camera, old.features);
   };
   if (m.pool && nb.size() > 1) {
     m.pool->ParallelFor(static_cast<int>(nb.size()), run);

@@ -70,10 +70,9 @@ using Match = std::pair<int, int>;  // (feature in new view, feature in old)
 // along the epipolar geometry (guided matching): candidates within
 // kMaxEpipolarDistance of the epipolar line in both directions, Lowe's
 // ratio test (orientation twins of the best do not count as second best),
-// the descriptor-distance bound and, optionally, mutual best.
+// the descriptor-distance bound.
 std::vector<Match> GuidedMatches(const Camera& ca, const Features& fa,
-                                 const Camera& cb, const Features& fb,
-                                 const TrackerOptions& opt);
+                                 const Camera& cb, const Features& fb);
 
 }  // namespace sparse_internal
 

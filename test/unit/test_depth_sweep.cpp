@@ -102,7 +102,6 @@ TEST(DepthSweep, RecoversBothPlaneDepthsExactly) {
     ASSERT_GE(seed.y, 0);
     ASSERT_LT(seed.x, gt.cols);
     ASSERT_LT(seed.y, gt.rows);
-    EXPECT_EQ(seed.normal, Eigen::Vector3d::Zero());
     // Away from the depth edge the sweep's best depth is the sample equal to
     // the plane's: the neighbouring samples are 2.4 % (near) and 1.6 % (far)
     // off.

@@ -288,7 +288,9 @@ TEST(ColmapWorkspaceWriter, RenderedSceneWithAnisotropicFocal) {
     for (size_t k = 0; k < vis[i].size(); ++k) {
       const uint32_t v = vis[i][k];
       ASSERT_LT(v, static_cast<uint32_t>(n));
-      if (k) EXPECT_LT(vis[i][k - 1], v);
+      if (k) {
+        EXPECT_LT(vis[i][k - 1], v);
+      }
       Eigen::Vector2d px;
       ASSERT_TRUE(model.views[v].camera.Project(gt.xyz[i].cast<double>(), &px));
       EXPECT_TRUE(model.views[v].camera.InImage(px));

@@ -37,19 +37,10 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
 struct Seed {
   int x = 0, y = 0;  // pixel (column, row) of R's working image
   double depth = 0;  // z
-  // The plane's unit normal in R's camera frame to start MPGC from (facing
-  // the camera); zero = fronto-parallel (the sparse features' seeds).
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  // The pixel already holds an accepted sample in the maps given to
-  // GrowRegions (a later pass, core/view_refinement.h): it is not matched
-  // again; its empty 4-neighbours are queued with its plane and confidence,
-  // as if it had just been grown. depth and normal are then unused.
-  bool held = false;
 };
 
 struct GrowStats {
   int seeds_tried = 0, seeds_accepted = 0;
-  int held_seeds = 0;          // held samples expanded (Seed::held)
   long long pixel_visits = 0;  // MPGC runs, seeds included
   int phases = 0;
   double cpu_seconds = 0;  // CPU time of the work run on pool threads
