@@ -1,6 +1,7 @@
 // Copyright wild_mvs authors. Timing and quality of the sparse tracker on a
 // dataset (cameras only; existing points are ignored).
-//   bench_sparse_tracker DATASET [max_features] [downscale] [threads]
+//   bench_sparse_tracker DATASET [max_features] [feature_max_image_size]
+//   [threads]
 // Prints feature extraction and matching/triangulation times, point count,
 // track-length histogram and reprojection error percentiles.
 #include <algorithm>
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
   using namespace wild_mvs;
   if (argc < 2) {
     std::cerr << "usage: " << argv[0]
-              << " DATASET [max_features] [downscale] [threads]\n";
+              << " DATASET [max_features] [feature_max_image_size] [threads]\n";
     return 2;
   }
   try {
@@ -36,7 +37,7 @@ int main(int argc, char** argv) {
     const Scene scene = LoadDataset(dopt);
     TrackerOptions opt;
     if (argc > 2) opt.features.max_features = std::atoi(argv[2]);
-    if (argc > 3) opt.features.downscale = std::atof(argv[3]);
+    if (argc > 3) opt.features.max_image_size = std::atoi(argv[3]);
     const int threads = argc > 4 ? std::atoi(argv[4]) : 2;
     opt.Check();
     ThreadPool pool(threads);

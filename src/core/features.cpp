@@ -24,8 +24,6 @@ constexpr double kSigma = 1.6;
 void FeatureOptions::Check() const {
   Require(max_features >= 0, "features.max_features = ", max_features,
           " must be >= 0 (0 = no cap)");
-  Require(downscale >= 1 && downscale <= 64, "features.downscale = ", downscale,
-          " must be in [1, 64]");
   Require(max_image_size == 0 || max_image_size >= 64,
           "features.max_image_size = ", max_image_size,
           " must be 0 (no limit) or >= 64");
@@ -40,11 +38,6 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("max_features"), &o->max_features,
             "keep at most this many SIFT features per view, 0 = no cap")
       .Min(0);
-  registry
-      ->Add(key("downscale"), &o->downscale,
-            "detect features on the image shrunk by this factor")
-      .Min(1)
-      .Max(64);
   registry
       ->Add(key("max_image_size"), &o->max_image_size,
             "detect features on images shrunk to this longest side, 0 = no "
@@ -130,12 +123,10 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options,
   const cv::Mat grey_full = ToGrey8(image, true);
   cv::Mat grey = grey_full;
   cv::Mat det_mask = mask;
-  double factor = options.downscale;
+  double factor = 1.0;
   const int longest = std::max(image.cols, image.rows);
-  if (options.max_image_size > 0 && longest > options.max_image_size) {
-    factor =
-        std::max(factor, static_cast<double>(longest) / options.max_image_size);
-  }
+  if (options.max_image_size > 0 && longest > options.max_image_size)
+    factor = static_cast<double>(longest) / options.max_image_size;
   // Full-resolution pixels per detection pixel, per axis (equal up to the
   // rounding of the shrunk size).
   double sx = 1.0, sy = 1.0;

@@ -90,13 +90,13 @@ TEST(Params, ReconstructYamlLoadsIntoTheNodes) {
   EXPECT_EQ(d.stream.mvs.sweep.below_seeds, 4);
   EXPECT_DOUBLE_EQ(d.stream.mvs.local.min_ncc, 0.25);
   EXPECT_EQ(d.stream.tracker.min_track_length, 3);
-  // tracker.features.downscale is not a depth node parameter: named, and
-  // the node keeps the library default.
-  EXPECT_EQ(
-      std::count(unknown.begin(), unknown.end(), "tracker/features/downscale"),
-      1);
-  EXPECT_DOUBLE_EQ(d.stream.tracker.features.downscale,
-                   FeatureOptions().downscale);
+  // tracker.features.max_image_size is not a depth node parameter: named,
+  // and the node keeps the library default.
+  EXPECT_EQ(std::count(unknown.begin(), unknown.end(),
+                       "tracker/features/max_image_size"),
+            1);
+  EXPECT_EQ(d.stream.tracker.features.max_image_size,
+            FeatureOptions().max_image_size);
   // The other sections of reconstruct.yaml are the CLI's (reported as
   // unknown, not errors), and so are the core's keys the node does not
   // read: every unknown name is a key of the CLI.

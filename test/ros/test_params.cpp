@@ -156,8 +156,8 @@ TEST(Params, DepthNodeKeys) {
        {"mvs.mpgc.bilateral_sigma_color", "mvs.mpgc.explain_margin",
         "mvs.mpgc.wide_drop_ncc", "mvs.local.wide_min_ncc",
         "mvs.mpgc.window_step", "consistency.max_relative_depth",
-        "tracker.features.downscale", "tracker.features.max_image_size",
-        "tracker.scene_depth", "tracker.max_neighbors"})
+        "tracker.features.max_image_size", "tracker.scene_depth",
+        "tracker.max_neighbors"})
     EXPECT_FALSE(r.Has(k)) << k;
 }
 
@@ -207,7 +207,7 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
       "  sweep: {below_seeds: 4}\n"
       "consistency: {min_consistent: 2, max_relative_depth: 0.02}\n"
       "tracker:\n"
-      "  features: {downscale: 2.0, max_features: 1234}\n"
+      "  features: {max_image_size: 1000, max_features: 1234}\n"
       "  min_track_length: 3\n";
   // The CLI's reading of the text ...
   MvsOptions mvs;
@@ -240,7 +240,7 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
           << o.key();
     }
   }
-  EXPECT_EQ(unknown.size(), 3u);  // downscale, bilateral, relative depth
+  EXPECT_EQ(unknown.size(), 3u);  // feature size, bilateral, relative depth
   EXPECT_EQ(d.stream.mvs.mpgc.window, 7);
   EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.drop_ncc, 0.5);
   EXPECT_DOUBLE_EQ(d.stream.mvs.local.min_ncc, 0.25);
@@ -248,8 +248,8 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
   EXPECT_EQ(d.stream.mvs.sweep.below_seeds, 4);
   EXPECT_EQ(d.stream.mvs.consistency.min_consistent, 2);
   EXPECT_EQ(d.stream.tracker.features.max_features, 1234);
-  EXPECT_DOUBLE_EQ(d.stream.tracker.features.downscale,
-                   FeatureOptions().downscale);
+  EXPECT_EQ(d.stream.tracker.features.max_image_size,
+            FeatureOptions().max_image_size);
   EXPECT_DOUBLE_EQ(d.stream.mvs.mpgc.bilateral_sigma_color,
                    MpgcOptions().bilateral_sigma_color);
 }

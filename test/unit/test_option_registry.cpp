@@ -21,7 +21,7 @@ TEST(OptionRegistry, StructNestingGivesTheKeys) {
   OptionRegistry r;
   cli::RegisterOptions(&c, &r);
   for (const char* key :
-       {"run.threads", "image.cache_mb", "tracker.features.downscale",
+       {"run.threads", "image.cache_mb", "tracker.features.max_image_size",
         "tracker.max_neighbors", "mvs.global.num_neighbors",
         "mvs.local.num_active", "mvs.mpgc.window", "mvs.mpgc.drop_ncc",
         "mvs.growing.revisit_margin", "mvs.sweep.below_seeds",
@@ -35,8 +35,8 @@ TEST(OptionRegistry, StructNestingGivesTheKeys) {
   EXPECT_DOUBLE_EQ(c.mvs.mpgc.drop_ncc, 0.55);
   r.Find("mvs.mpgc.window")->SetInt(7);
   EXPECT_EQ(c.mvs.mpgc.window, 7);
-  r.Find("tracker.features.downscale")->SetInt(2);  // int for a double
-  EXPECT_DOUBLE_EQ(c.tracker.features.downscale, 2.0);
+  r.Find("meshing.trim_distance")->SetInt(3);  // int for a double
+  EXPECT_DOUBLE_EQ(c.mesh.trim_distance, 3.0);
   r.Find("ablation.local_view_selection")->SetBool(false);
   EXPECT_FALSE(c.mvs.ablation.local_view_selection);
   r.Find("ablation.linearize")->SetBool(false);
@@ -50,6 +50,9 @@ TEST(OptionRegistry, StructNestingGivesTheKeys) {
     EXPECT_FALSE(o.help().empty()) << o.key();
   }
   EXPECT_THROW(r.Add("run.threads", &c.run.threads, "again"), Error);
+  // The options a user of `reconstruct` may need, and no more (the
+  // ablation switches included).
+  EXPECT_LE(r.options().size(), 60u);
 }
 
 // A copy of another registry's option sets the same field and keeps its

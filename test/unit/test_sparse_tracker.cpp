@@ -471,8 +471,8 @@ TEST(SparseTracker, OptionsCheckNamesTheOption) {
   o.min_track_length = 1;
   expect_bad(o, "min_track_length");
   o = TrackerOptions();
-  o.features.downscale = 0.5;
-  expect_bad(o, "downscale");
+  o.features.max_image_size = 10;
+  expect_bad(o, "max_image_size");
   o = TrackerOptions();
   o.features.max_features = -3;
   expect_bad(o, "max_features");

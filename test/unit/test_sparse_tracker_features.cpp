@@ -52,7 +52,7 @@ TEST(Features, BlobCentreInPixelConvention) {
   const cv::Mat img = Blobs(256, 224, centres, sigma);
   for (double downscale : {1.0, 2.0}) {
     FeatureOptions opt;
-    opt.downscale = downscale;
+    opt.max_image_size = downscale > 1 ? 128 : 0;  // 256 px: factor 2
     const Features f = ExtractFeatures(img, opt);
     ASSERT_GE(f.size(), 4) << "downscale " << downscale;
     for (const Eigen::Vector2d& c : centres) {
@@ -91,7 +91,7 @@ TEST(Features, DownscaleKeepsScaleInFullResolutionPixels) {
   const std::vector<Eigen::Vector2d> centres = {{100.5, 100.5}};
   const cv::Mat img = Blobs(200, 200, centres, 5.0);
   FeatureOptions o1, o2;
-  o2.downscale = 2.0;
+  o2.max_image_size = 100;  // factor 2
   const Features f1 = ExtractFeatures(img, o1), f2 = ExtractFeatures(img, o2);
   const int i1 = Nearest(f1, centres[0]), i2 = Nearest(f2, centres[0]);
   ASSERT_GE(i1, 0);
@@ -155,7 +155,7 @@ TEST(Features, RejectsBadInput) {
   EXPECT_THROW(ExtractFeatures(cv::Mat(10, 10, CV_16UC3), FeatureOptions()),
                Error);
   FeatureOptions bad;
-  bad.downscale = 0.5;
+  bad.max_image_size = 10;
   EXPECT_THROW(ExtractFeatures(cv::Mat(10, 10, CV_8UC1), bad), Error);
   EXPECT_THROW(ExtractFeatures(cv::Mat(10, 10, CV_8UC1), FeatureOptions(),
                                cv::Mat(5, 5, CV_8UC1)),

@@ -122,7 +122,8 @@ TEST(SparseTrackerRendered, SlantedPlaneDownscaledFeatures) {
       testing::Render(testing::SlantedPlaneSpec(30, 5));
   ImageCache cache(s.Loader(), 64);
   TrackerOptions opt;
-  opt.features.downscale = 1.5;
+  // Detected at 2/3 of the size (the longest side is the width).
+  opt.features.max_image_size = s.scene.views[0].camera.width * 2 / 3;
   const std::vector<SparsePoint> pts = ComputeSparseTracks(s.scene, cache, opt);
   const RenderedQuality q = Evaluate(s, pts);
   std::cout << q.points << " points; relative depth error median "

@@ -23,13 +23,11 @@ struct FeatureOptions {
   // Keep at most this many features per view (strongest response first);
   // bounds memory (128 bytes per descriptor) and matching time. 0 = no cap.
   int max_features = 4000;
-  // Features are detected on the image shrunk by this factor (>= 1) when
-  // views are large; positions and scales are reported in full-resolution
-  // pixels.
-  double downscale = 1.0;
-  // Also shrink so that the longest side is at most this many pixels (large
-  // photos: SIFT time grows with the pixel count while the extra
-  // features of a 6-megapixel image rarely help); 0 = no limit.
+  // Features are detected on the image shrunk so that its longest side is
+  // at most this many pixels (large photos: SIFT time grows with the pixel
+  // count while the extra features of a 6-megapixel image rarely help);
+  // positions and scales are reported in full-resolution pixels. 0 = no
+  // limit, else >= 64.
   int max_image_size = 2000;
   void Check() const;
 };
