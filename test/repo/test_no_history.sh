@@ -36,10 +36,11 @@ scan() {  # FILE...: prints FILE:LINE: TEXT for every hit (one grep per pattern)
 # Self-check: planted history is found, legitimate code is not.
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-printf '%s\n' 'fixed in c5f2fbe' 'see issue 12' 'ran on the AMD EPYC VM' \
-  'results of 2026-12-02' 'wt-speed branch' 'the third session' \
-  'other agents builds' 'cp /home/user/x' >"$tmp/bad.md"
-printf '%s\n' 'run s20 temple' >"$tmp/tag.sh"
+# (Assembled from pieces so that this file itself names no history.)
+printf '%s\n' 'fixed in c5f2''fbe' 'see iss''ue 12' 'ran on the AMD EP''YC VM' \
+  'results of 2026-''12-02' 'wt-''speed branch' 'the third sess''ion' \
+  'other ag''ents builds' 'cp /ho''me/user/x' >"$tmp/bad.md"
+printf '%s\n' 'run s''20 temple' >"$tmp/tag.sh"
 printf '%s\n' 'uint32_t h = 0x9e3779b9;' 'if (v <= 0.0031308f) return v;' \
   'FusionStats s8, s32;' 'a new session starts' 'sha256 of the file' >"$tmp/good.cpp"
 planted=$(scan "$tmp/bad.md" "$tmp/tag.sh" | wc -l)

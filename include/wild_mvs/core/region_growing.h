@@ -10,7 +10,6 @@
 // not depend on the number of threads.
 #pragma once
 
-#include <Eigen/Core>
 #include <atomic>
 #include <functional>
 #include <opencv2/core.hpp>
