@@ -9,6 +9,11 @@
 #   fountain  bench/run_fountain.sh: fountain-P11 at 1536x1024 against its
 #             ground-truth depth (coverage, within 1 %, off > 5 %,
 #             background) and the fused cloud's F at 1 / 2 / 5 cm;
+#   photos    bench/run_photos.sh: fountain-P11 from its photos alone
+#             (`wild_mvs photos`, Debian's colmap) against the same
+#             reconstruction on the ground-truth cameras, F at 1 / 2 / 5 cm
+#             after a similarity alignment by the camera centres; needs
+#             colmap, else not run;
 #   families  bench/run_families.sh: the rendered scene families with
 #             exact ground truth (relief, weak, courtyard), report seeds;
 #   scale     bench/run_scale.sh: CPU-s per view and peak RSS against the
@@ -29,7 +34,7 @@
 #                collections of 10 / 20 / 40 views at 160 px): minutes
 #                instead of hours; RESULTS.md says so at the top
 #   --skip LIST  comma-separated sections not to run (speed, fountain,
-#                families, scale, live); RESULTS.md lists them as not run
+#                photos, families, scale, live); RESULTS.md lists them as not run
 #   --out DIR    raw outputs (default bench/out/all-<UTC time>, ignored by git)
 # Environment: WILD_MVS_DATASETS (default ../shared/datasets of the repo;
 # fountain needs it, temple uses its GT model when present), BUILD_DIR
@@ -57,8 +62,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 for s in ${SKIP//,/ }; do
-  case "$s" in speed | fountain | families | scale | live) ;; *)
-    echo "run_all.sh: --skip takes speed, fountain, families, scale, live; not '$s'" >&2; exit 2 ;;
+  case "$s" in speed | fountain | photos | families | scale | live) ;; *)
+    echo "run_all.sh: --skip takes speed, fountain, photos, families, scale, live; not '$s'" >&2; exit 2 ;;
   esac
 done
 skipped() { [[ ",$SKIP," == *",$1,"* ]]; }
@@ -111,6 +116,18 @@ fi
 if ! skipped fountain; then
   bash "$ROOT/bench/run_fountain.sh" --size "$FOUNTAIN_SIZE" --threads "$THREADS" \
     --out "$OUT/fountain" || failed fountain
+fi
+PHOTOS_NOTE=""
+if ! skipped photos; then
+  if ! command -v colmap >/dev/null; then
+    PHOTOS_NOTE="Not run: needs colmap (apt-get install colmap)."
+  else
+    GT_ARGS=()
+    [ -f "$OUT/fountain/run_$FOUNTAIN_SIZE/fused.ply" ] &&
+      GT_ARGS=(--gt-run "$OUT/fountain/run_$FOUNTAIN_SIZE")
+    bash "$ROOT/bench/run_photos.sh" --size "$FOUNTAIN_SIZE" --threads "$THREADS" \
+      --out "$OUT/photos" ${GT_ARGS[@]+"${GT_ARGS[@]}"} || failed photos
+  fi
 fi
 FAMILIES_NOTE=""
 if ! skipped families; then
@@ -206,6 +223,7 @@ fi
   printf 'families_note\t%s\n' "$FAMILIES_NOTE"
   printf 'scale_args\t%s\n' "$SCALE_ARGS"
   printf 'live_note\t%s\n' "$LIVE_NOTE"
+  printf 'photos_note\t%s\n' "$PHOTOS_NOTE"
   printf 'scene_size\t%s\n' "$SCENE_SIZE"
 } >"$OUT/meta.tsv"
 "$PY" "$ROOT/bench/make_results.py" "$OUT" "$ROOT"
