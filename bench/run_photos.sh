@@ -12,8 +12,8 @@
 #
 #   bench/run_photos.sh [--size PX] [--threads N] [--out DIR] [--gt-run DIR]
 # --size: working size, longest side in pixels (default 1536);
-# --gt-run DIR: a finished run on the ground-truth cameras at the same size
-#   (bench/run_fountain.sh's DIR/run_PX), instead of making one here.
+# --gt-run DIR: bench/run_fountain.sh's finished run at the same size (its
+#   DIR/run_PX), instead of making one here in DIR/fountain.
 # Writes DIR/photos.tsv (DIR default bench/out/photos): one row per run,
 # and prints it.
 # Environment: WILD_MVS_DATASETS (default ../shared/datasets of the repo),
@@ -63,21 +63,19 @@ for mode in per_photo single; do
     { tail -20 "$OUT/photos_${mode}_$SIZE.log" >&2; echo "run_photos.sh: wild_mvs photos failed" >&2; exit 1; }
 done
 
+# The ground-truth cameras: bench/run_fountain.sh's run (its reconstruct,
+# ground-truth cloud, cloud scores and CPU time), made here unless given.
 if [ -z "$GT_RUN" ]; then
-  GT_RUN="$OUT/gt_cameras_$SIZE"
-  rm -rf "$GT_RUN"
-  echo "== fountain-P11 ground-truth cameras at $SIZE px: wild_mvs reconstruct" >&2
-  /usr/bin/time -f '%U %S %M' -o "$OUT/time_gt_$SIZE.txt" \
-    "$BIN/wild_mvs" reconstruct "$F" "$GT_RUN" --model "$F/colmap_sift_gt" --images "$F/images" \
-    --max-image-size "$SIZE" --stages depth,fuse --threads "$THREADS" >"$OUT/gt_$SIZE.log" 2>&1 ||
-    { tail -20 "$OUT/gt_$SIZE.log" >&2; echo "run_photos.sh: reconstruct failed" >&2; exit 1; }
+  bash "$ROOT/bench/run_fountain.sh" --size "$SIZE" --threads "$THREADS" --out "$OUT/fountain" >/dev/null
+  GT_RUN="$OUT/fountain/run_$SIZE"
 fi
-[ -f "$GT_RUN/fused.ply" ] || { echo "run_photos.sh: no $GT_RUN/fused.ply" >&2; exit 1; }
-
-GT="$OUT/gt_cloud_s2_v0.005.ply"
-[ -f "$GT" ] || "$BIN/wild_mvs" eval make-gt-cloud --dataset "$F" --stride 2 --voxel 0.005 "$GT" >&2
-"$BIN/wild_mvs" eval cloud "$GT_RUN/fused.ply" "$GT" --tau 0.01,0.02,0.05 --voxel 0.005 \
-  --json "$OUT/eval_gt_$SIZE.json" >/dev/null
+GT_DIR="$(cd "$GT_RUN/.." && pwd)"
+for f in "$GT_RUN/fused.ply" "$GT_RUN/eval_cloud.json" "$GT_DIR/gt_cloud_s2_v0.005.ply"; do
+  [ -f "$f" ] || { echo "run_photos.sh: no $f (not a bench/run_fountain.sh run)" >&2; exit 1; }
+done
+GT="$GT_DIR/gt_cloud_s2_v0.005.ply"
+cp "$GT_RUN/eval_cloud.json" "$OUT/eval_gt_$SIZE.json"
+[ ! -f "$GT_DIR/time_$SIZE.txt" ] || cp "$GT_DIR/time_$SIZE.txt" "$OUT/time_gt_$SIZE.txt"
 for mode in per_photo single; do
   photos="$OUT/photos_${mode}_$SIZE"
   "$PY" "$ROOT/bench/align_cloud.py" "$GT_RUN/cameras" "$photos/cameras" \
