@@ -60,12 +60,12 @@ endif()
 # time, which fails on catkin's build RPATH). Tests and fuzz harnesses keep
 # CMake's build RPATH.
 set(WILD_MVS_INSTALLED_TARGETS ${WILD_MVS_ROS_EXECUTABLES} wild_mvs wild_mvs_ros
-  wild_mvs_core wild_mvs_io wild_mvs_stream)
+  wild_mvs_core wild_mvs_io wild_mvs_pipeline wild_mvs_stream)
 set_target_properties(${WILD_MVS_INSTALLED_TARGETS} PROPERTIES
   BUILD_WITH_INSTALL_RPATH ON INSTALL_RPATH "$ORIGIN/..;$ORIGIN/../lib")
 install(TARGETS ${WILD_MVS_ROS_EXECUTABLES}
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
-install(TARGETS wild_mvs_ros wild_mvs_core wild_mvs_io wild_mvs_stream
+install(TARGETS wild_mvs_ros wild_mvs_core wild_mvs_io wild_mvs_pipeline wild_mvs_stream
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   RUNTIME DESTINATION ${CATKIN_GLOBAL_BIN_DESTINATION})

@@ -51,7 +51,7 @@ generate_messages(DEPENDENCIES std_msgs sensor_msgs geometry_msgs)
 
 catkin_package(
   INCLUDE_DIRS include
-  LIBRARIES wild_mvs_core wild_mvs_io wild_mvs_stream wild_mvs_ros
+  LIBRARIES wild_mvs_core wild_mvs_io wild_mvs_pipeline wild_mvs_stream wild_mvs_ros
   CATKIN_DEPENDS roscpp nodelet std_msgs std_srvs sensor_msgs geometry_msgs nav_msgs
     dynamic_reconfigure
     visualization_msgs diagnostic_msgs diagnostic_updater image_transport

@@ -22,6 +22,8 @@
 #include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/report_json.h"
 #include "wild_mvs/io/sparse_tracks_file.h"
+#include "wild_mvs/pipeline/depth_controller.h"
+#include "wild_mvs/pipeline/file_workspace.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -32,39 +34,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-std::string LogPath(const std::string& out, const std::string& stem) {
-  return out + "/log/" + stem + ".json";
-}
-
-std::string JsonString(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      o += '\\';
-      o += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-      o += buf;
-    } else {
-      o += c;
-    }
-  }
-  return o + "\"";
-}
-
-// "samples" of a finished view's log, or -1 when unreadable.
-long long SamplesFromLog(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::smatch m;
-  const std::string text = ss.str();
-  static const std::regex re("\"samples\"\\s*:\\s*([0-9]+)");
-  if (!std::regex_search(text, m, re)) return -1;
-  return std::stoll(m[1].str());
 }
 
 }  // namespace
@@ -103,47 +72,83 @@ SparseSummary ComputeSceneTracks(Scene* scene, const ReconstructConfig& config,
   return s;
 }
 
-bool ViewOutputsComplete(const std::string& out, const std::string& stem) {
-  std::error_code ec;
-  return DepthMapFilesExist(out, stem) &&
-         fs::is_regular_file(LogPath(out, stem), ec);
-}
-
 namespace {
 
-// Writes one view's depth map and its log (log last: the view is complete
-// once it exists). extra_json: more members for the log ("" = none).
-void WriteViewOutputs(const View& view, const std::string& dir,
-                      const DepthMap& map,
-                      const std::vector<std::string>& neighbor_names,
-                      const std::string& json_body, const std::string& extra) {
-  WriteDepthMapFiles(dir, view.Stem(), map, neighbor_names, true);
-  std::string json = json_body;
-  if (json.rfind("{\n", 0) == 0) {
-    json = "{\n  \"view\": " + JsonString(view.name) +
-           ",\n  \"stem\": " + JsonString(view.Stem()) + "," + extra +
-           json.substr(1);
+using Stage = DepthWorkspace::Stage;
+using Step = DepthRunObserver::Step;
+
+// The depth pipeline's progress on the command line: a bar on a terminal,
+// a line per view in logs.
+class ProgressObserver : public DepthRunObserver {
+ public:
+  ProgressObserver(const Scene& scene, const FileDepthWorkspace& workspace,
+                   std::ostream& log)
+      : scene_(scene), workspace_(workspace), log_(log) {}
+
+  void StepBegins(Step step, int total) override {
+    total_ = total;
+    progress_ = std::make_unique<Progress>(
+        step == Step::kMatch ? "depth" : "consistency", total, log_,
+        StderrIsTerminal());
   }
-  WriteFileAtomically(LogPath(dir, view.Stem()),
-                      [&](std::ostream& os) { os << json; });
-}
+  void StepEnds(Step) override {
+    progress_->Finish();
+    progress_.reset();
+  }
+  void Skipped(int index, int key, Stage done, long long samples) override {
+    const std::string prefix = Prefix(Step::kMatch, index, key);
+    progress_->Skip(done == Stage::kFinal
+                        ? Msg(prefix, ": done earlier, skipped (",
+                              samples >= 0 ? std::to_string(samples) : "?",
+                              " samples; --force recomputes)")
+                        : Msg(prefix, ": matched earlier, to be filtered"));
+  }
+  void Begins(Step, int, int key) override {
+    progress_->Begin(scene_.views[key].Stem());
+  }
+  void Failed(Step step, int index, int key,
+              const std::string& error) override {
+    progress_->End(Msg(Prefix(step, index, key), ": FAILED: ", error));
+  }
+  void Done(Step step, int index, int key, const ViewResult& r) override {
+    const std::string prefix = Prefix(step, index, key);
+    if (step == Step::kFilter) {
+      progress_->End(
+          r.neighbor_maps == 0 && r.consistency.samples > 0
+              ? Msg(prefix, ": no neighbour's map in ",
+                    workspace_.Folder(Stage::kRaw),
+                    " to check against (reconstruct its neighbours too): ",
+                    r.consistency.samples, " samples kept unfiltered")
+              : Msg(prefix, ": kept ", r.consistency.kept, " of ",
+                    r.consistency.samples, " samples (", r.neighbor_maps,
+                    " neighbour maps)"));
+      return;
+    }
+    const DepthMap& map = r.map;
+    const int valid = map.CountValid();
+    const double fill =
+        map.empty() ? 0.0 : 100.0 * valid / (map.width() * map.height());
+    std::string note = Msg(
+        prefix, ": ", valid, " samples (", map.width(), "x", map.height(), ", ",
+        static_cast<int>(fill + 0.5), "% filled), ", r.report.seeds_accepted,
+        "/", r.report.seeds_tried, " seeds, ", r.report.planar_samples,
+        " from planes, ", Progress::FormatDuration(r.report.seconds));
+    for (const std::string& f : r.report.fallbacks) note += "\n    " + f;
+    progress_->End(note);
+  }
 
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+ private:
+  std::string Prefix(Step step, int index, int key) const {
+    return Msg(step == Step::kMatch ? "depth " : "consistency ", index + 1, "/",
+               total_, " ", scene_.views[key].Stem());
+  }
 
-// The view log's body without the "view"/"stem" members the writer adds
-// (so that a raw log can be rewritten with more members).
-std::string StripViewHeader(const std::string& json) {
-  static const std::regex re(
-      "^\\{\\n  \"view\": \"(?:[^\"\\\\]|\\\\.)*\",\\n  \"stem\": "
-      "\"(?:[^\"\\\\]|\\\\.)*\",");
-  return std::regex_replace(json, re, "{",
-                            std::regex_constants::format_first_only);
-}
+  const Scene& scene_;
+  const FileDepthWorkspace& workspace_;
+  std::ostream& log_;
+  int total_ = 0;
+  std::unique_ptr<Progress> progress_;
+};
 
 }  // namespace
 
@@ -154,191 +159,28 @@ DepthStageResult RunDepthStage(const Scene& scene,
                                ThreadPool* pool, const std::string& out,
                                bool force, std::ostream& log, bool filter_now) {
   const auto t0 = Clock::now();
-  DepthStageResult r;
+  const DepthController controller(config.mvs, pool);
   // With the consistency filter the MVS maps go to OUT/raw first; the
   // filter writes the final maps to OUT.
-  const bool filter = config.mvs.ablation.consistency;
-  const std::string raw = filter ? out + "/raw" : out;
-  Progress progress("depth", static_cast<int>(views.size()), log,
-                    StderrIsTerminal());
-  const int total = static_cast<int>(views.size());
-  std::vector<int> to_filter;
-  // Once for the run, not per view (it grows with the collection).
-  const std::vector<std::vector<int>> points_per_view = scene.PointsPerView();
-  for (int k = 0; k < total; ++k) {
-    const int v = views[k];
-    const View& view = scene.views[v];
-    const std::string stem = view.Stem();
-    const std::string prefix = Msg("depth ", k + 1, "/", total, " ", stem);
-    if (!force && ViewOutputsComplete(out, stem)) {
-      const long long samples = SamplesFromLog(LogPath(out, stem));
-      if (samples > 0) r.samples += samples;
-      ++r.skipped;
-      progress.Skip(Msg(prefix, ": done earlier, skipped (",
-                        samples >= 0 ? std::to_string(samples) : "?",
-                        " samples; --force recomputes)"));
-      continue;
-    }
-    if (filter && !force && ViewOutputsComplete(raw, stem)) {
-      to_filter.push_back(v);
-      if (!filter_now) {  // a shard: resumed, its raw samples counted
-        const long long samples = SamplesFromLog(LogPath(raw, stem));
-        if (samples > 0) r.samples += samples;
-        ++r.skipped;
-      }
-      progress.Skip(Msg(prefix, ": matched earlier, to be filtered"));
-      continue;
-    }
-    progress.Begin(stem);
-    DepthMap map;
-    ViewReport report;
-    try {
-      const cv::Mat mask = LoadViewMask(view);
-      map = ReconstructView(scene, v, images, config.mvs, pool, &report, mask,
-                            &points_per_view);
-    } catch (const Error& e) {
-      r.failures.push_back(Msg(view.name, ": ", e.what()));
-      progress.End(Msg(prefix, ": FAILED: ", e.what()));
-      continue;
-    }
-    // Output errors (unwritable folder, full disk) abort the run; every
-    // file is atomic, the log last, so a view is either complete or redone.
-    std::vector<std::string> names;
-    for (int n : map.neighbors) {
-      if (n >= 0 && n < static_cast<int>(scene.views.size())) {
-        names.push_back(scene.views[n].name);
-      }
-    }
-    WriteViewOutputs(view, raw, map, names, ViewReportJson(report, scene), "");
-    const int valid = map.CountValid();
-    if (filter) {
-      to_filter.push_back(v);
-    }
-    if (!filter || !filter_now) {
-      r.samples += valid;
-      ++r.computed;
-    }
-    const double fill =
-        map.empty() ? 0.0 : 100.0 * valid / (map.width() * map.height());
-    std::string note = Msg(
-        prefix, ": ", valid, " samples (", map.width(), "x", map.height(), ", ",
-        static_cast<int>(fill + 0.5), "% filled), ", report.seeds_accepted, "/",
-        report.seeds_tried, " seeds, ", report.planar_samples, " from planes, ",
-        Progress::FormatDuration(report.seconds));
-    for (const std::string& f : report.fallbacks) note += "\n    " + f;
-    progress.End(note);
-  }
-  progress.Finish();
-  ReleaseFreeMemory();  // the stages' peaks do not add up
-  if (filter && !filter_now) {
-    r.unfiltered = static_cast<int>(to_filter.size());
-  } else if (filter && !to_filter.empty()) {
-    FilterStageResult f = FilterDepthMaps(
-        scene, to_filter, config.mvs.consistency, out + "/raw", out, pool, log);
-    ReleaseFreeMemory();
-    r.computed += f.filtered;
-    r.samples += f.kept;
-    r.consistency_samples += f.samples;
-    r.consistency_kept += f.kept;
-    for (const std::string& e : f.failures) r.failures.push_back(e);
-  }
+  FileDepthWorkspace workspace(scene, out, controller.filters());
+  ProgressObserver progress(scene, workspace, log);
+  DepthRun run;
+  run.scene = &scene;
+  run.views = views;
+  run.images = &images;
+  run.mask = [&scene](int v) { return LoadViewMask(scene.views[v]); };
+  run.force = force;
+  run.filter_now = filter_now;
+  const DepthRunSummary s = controller.Run(run, &workspace, &progress);
+  DepthStageResult r;
+  r.computed = controller.filters() && filter_now ? s.filtered : s.matched;
+  r.skipped = s.skipped;
+  r.samples = s.samples;
+  r.consistency_samples = s.filter_samples;
+  r.consistency_kept = s.filter_kept;
+  r.unfiltered = s.unfiltered;
+  r.failures = s.failures;
   r.seconds = SecondsSince(t0);
-  return r;
-}
-
-FilterStageResult FilterDepthMaps(const Scene& scene,
-                                  const std::vector<int>& views,
-                                  const GeometricConsistencyOptions& options,
-                                  const std::string& raw,
-                                  const std::string& out, ThreadPool* pool,
-                                  std::ostream& log,
-                                  const std::string& member) {
-  options.Check();
-  FilterStageResult r;
-  std::map<std::string, int> by_name;
-  for (size_t i = 0; i < scene.views.size(); ++i)
-    by_name[scene.views[i].name] = static_cast<int>(i);
-  const int total = static_cast<int>(views.size());
-  struct Job {
-    DepthMapFiles ref;
-    ConsistencyStats stats;
-    int neighbor_maps = 0;
-    std::string error;
-  };
-  std::vector<Job> jobs(views.size());
-  Progress progress("consistency", total, log, StderrIsTerminal());
-  // One view per task: each reads its raw map and its neighbours' (the
-  // neighbours' maps are read again by every view that needs them: a few
-  // MB each, and memory stays bounded by threads x neighbours).
-  auto run = [&](int k) {
-    Job& job = jobs[k];
-    const View& view = scene.views[views[k]];
-    try {
-      job.ref = ReadDepthMapFiles(raw, view.Stem());
-      std::vector<DepthMapFiles> nbs;
-      for (const std::string& name : job.ref.neighbor_names) {
-        auto it = by_name.find(name);
-        if (it == by_name.end()) continue;
-        const std::string stem = scene.views[it->second].Stem();
-        if (!DepthMapFilesExist(raw, stem)) continue;
-        nbs.push_back(ReadDepthMapFiles(raw, stem));
-      }
-      std::vector<const DepthMap*> ptrs;
-      for (const DepthMapFiles& n : nbs) ptrs.push_back(&n.map);
-      job.neighbor_maps = static_cast<int>(ptrs.size());
-      FilterByConsistency(&job.ref.map, ptrs, options, &job.stats);
-    } catch (const Error& e) {
-      job.error = e.what();
-    }
-  };
-  const int chunk = pool ? std::max(1, pool->size()) : 1;
-  for (int k0 = 0; k0 < total; k0 += chunk) {
-    const int n = std::min(chunk, total - k0);
-    if (pool && n > 1) {
-      pool->ParallelFor(n, [&](int i) { run(k0 + i); });
-    } else {
-      for (int i = 0; i < n; ++i) run(k0 + i);
-    }
-    // Written in order by this thread (atomic files, the log last).
-    for (int k = k0; k < k0 + n; ++k) {
-      const View& view = scene.views[views[k]];
-      Job& job = jobs[k];
-      const std::string prefix =
-          Msg("consistency ", k + 1, "/", total, " ", view.Stem());
-      progress.Begin(view.Stem());
-      if (!job.error.empty()) {
-        r.failures.push_back(Msg(view.name, ": ", job.error));
-        progress.End(Msg(prefix, ": FAILED: ", job.error));
-        continue;
-      }
-      const std::string extra =
-          Msg("\n  \"", member, "\": {\"samples_before\": ", job.stats.samples,
-              ", \"kept\": ", job.stats.kept,
-              ", \"neighbor_maps\": ", job.neighbor_maps, "},");
-      // The raw log with the filtered count as its "samples" (written once:
-      // the log marks the view complete).
-      static const std::regex samples_re("\"samples\": [0-9]+");
-      const std::string body = std::regex_replace(
-          StripViewHeader(ReadText(LogPath(raw, view.Stem()))), samples_re,
-          Msg("\"samples\": ", job.stats.kept),
-          std::regex_constants::format_first_only);
-      WriteViewOutputs(view, out, job.ref.map, job.ref.neighbor_names, body,
-                       extra);
-      ++r.filtered;
-      r.samples += job.stats.samples;
-      r.kept += job.stats.kept;
-      progress.End(
-          job.neighbor_maps == 0 && job.stats.samples > 0
-              ? Msg(prefix, ": no neighbour's map in ", raw,
-                    " to check against (reconstruct its neighbours too): ",
-                    job.stats.samples, " samples kept unfiltered")
-              : Msg(prefix, ": kept ", job.stats.kept, " of ",
-                    job.stats.samples, " samples (", job.neighbor_maps,
-                    " neighbour maps)"));
-      job.ref = DepthMapFiles();
-    }
-  }
-  progress.Finish();
   return r;
 }
 
@@ -347,14 +189,15 @@ FilterStageResult FilterPendingViews(const Scene& scene, const MvsOptions& mvs,
                                      std::ostream& log) {
   FilterStageResult r;
   if (!mvs.ablation.consistency) return r;
-  const std::string raw = out + "/raw";
+  FileDepthWorkspace workspace(scene, out, true);
+  const std::string& raw = workspace.Folder(Stage::kRaw);
   std::vector<int> pending;
   int missing = 0;
   for (size_t i = 0; i < scene.views.size(); ++i) {
-    const std::string stem = scene.views[i].Stem();
-    const bool done = ViewOutputsComplete(out, stem);
-    if (ViewOutputsComplete(raw, stem)) {
-      if (!done) pending.push_back(static_cast<int>(i));
+    const int v = static_cast<int>(i);
+    const bool done = workspace.Has(Stage::kFinal, v);
+    if (workspace.Has(Stage::kRaw, v)) {
+      if (!done) pending.push_back(v);
     } else if (!done) {
       ++missing;
     }
@@ -371,7 +214,16 @@ FilterStageResult FilterPendingViews(const Scene& scene, const MvsOptions& mvs,
            "shard before 'wild_mvs fuse')"
         << std::endl;
   }
-  r = FilterDepthMaps(scene, pending, mvs.consistency, raw, out, pool, log);
+  const DepthController controller(mvs, pool);
+  ProgressObserver progress(scene, workspace, log);
+  DepthRun run;
+  run.scene = &scene;
+  run.views = pending;
+  const DepthRunSummary s = controller.FilterViews(run, &workspace, &progress);
+  r.filtered = s.filtered;
+  r.samples = s.filter_samples;
+  r.kept = s.filter_kept;
+  r.failures = s.failures;
   if (!r.failures.empty()) {
     std::string list;
     for (const std::string& f : r.failures) list += "\n  " + f;

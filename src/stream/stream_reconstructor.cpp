@@ -7,8 +7,8 @@
 #include <opencv2/imgproc.hpp>
 #include <unordered_map>
 
-#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/global_view_selection.h"
+#include "wild_mvs/pipeline/depth_controller.h"
 
 namespace wild_mvs {
 
@@ -468,10 +468,15 @@ double StreamReconstructor::MatchKeyframe(const Snapshot& snap, int ref,
                                           StreamResult* result) {
   const std::vector<KeyframePtr>& kfs = snap.keyframes;
   ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
-  ViewReport report;
-  result->depth =
-      ReconstructView(snap.scene, ref, cache, mvs, inner_pool_.get(), &report,
-                      cv::Mat(), &snap.points_per_view, &cancel_);
+  ViewProblem problem;
+  problem.scene = &snap.scene;
+  problem.ref = ref;
+  problem.images = &cache;
+  problem.points_per_view = &snap.points_per_view;
+  ViewResult matched =
+      DepthController(mvs, inner_pool_.get(), &cancel_).Match(problem);
+  result->depth = std::move(matched.map);
+  const ViewReport& report = matched.report;
   result->depth.view = static_cast<int>(kfs[ref]->id);
   result->depth.neighbors.clear();
   result->neighbor_ids.clear();
@@ -540,8 +545,10 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
 
 void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
   StreamResult result;
-  std::vector<std::shared_ptr<const DepthMap>> held;
-  GeometricConsistencyOptions consistency;
+  // The neighbours' maps the offline filter would see (keyed by keyframe
+  // id, as the map's neighbours), shared, not copied.
+  MemoryDepthWorkspace workspace;
+  MvsOptions mvs;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = unrevised_.find(id);
@@ -552,21 +559,17 @@ void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
     result = it->second;
     for (uint32_t n : result.neighbor_ids) {
       auto m = maps_.find(n);
-      if (m != maps_.end()) held.push_back(m->second);
+      if (m != maps_.end())
+        workspace.Put(DepthWorkspace::Stage::kRaw, static_cast<int>(n),
+                      m->second);
     }
-    consistency = options_.mvs.consistency;
+    mvs = options_.mvs;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  // The arrays may be shared with a delivered result or with maps_.
-  result.depth.depth = result.depth.depth.clone();
-  result.depth.normal = result.depth.normal.clone();
-  result.depth.confidence = result.depth.confidence.clone();
-  std::vector<const DepthMap*> neighbors;
-  for (const auto& m : held) neighbors.push_back(m.get());
   std::string error;
   try {
-    ConsistencyStats stats;
-    FilterByConsistency(&result.depth, neighbors, consistency, &stats);
+    result.depth =
+        DepthController(mvs, nullptr).Filter(result.depth, workspace).map;
   } catch (const std::exception& e) {
     error = e.what();
   }

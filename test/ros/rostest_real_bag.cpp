@@ -41,11 +41,11 @@
 #include "ros_test_scene.h"
 #include "rostest_util.h"
 #include "test_paths.h"
-#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/metrics.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/core/thread_pool.h"
+#include "wild_mvs/pipeline/depth_controller.h"
 #include "wild_mvs/ros/conversions.h"
 
 namespace wild_mvs {
@@ -448,10 +448,11 @@ TEST_F(RealBag, DepthMapsMatchTheGroundTruth) {
   }
 }
 
-// The live path runs the offline pipeline's steps (matching, then the
-// consistency step as a revision): its final maps are as accurate as the
-// offline ones on the same images (sparse tracks from the known poses,
-// every view matched against its best neighbours, consistency filter).
+// The live path runs the offline pipeline (DepthController: matching, then
+// the consistency step as a revision): its final maps are as accurate and
+// nearly as complete as the offline ones on the same images (sparse tracks
+// from the known poses, every view matched against its best neighbours,
+// consistency filter).
 TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
   const Playback& p = *playback_;
   ASSERT_FALSE(p.views.empty());
@@ -484,19 +485,22 @@ TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
   ImageCache images([&s](int v) { return s.images[v]; }, 256);
   scene.points =
       ComputeSparseTracks(scene, images, TrackerOptions(), &pool, nullptr);
-  std::vector<DepthMap> raw(scene.views.size());
+  // The library's pipeline, as `wild_mvs reconstruct` runs it, its maps
+  // held in memory.
+  const DepthController controller(mvs, &pool);
+  MemoryDepthWorkspace workspace;
+  DepthRun run;
+  run.scene = &scene;
   for (size_t v = 0; v < scene.views.size(); ++v)
-    raw[v] = ReconstructView(scene, static_cast<int>(v), images, mvs, &pool,
-                             nullptr, cv::Mat());
+    run.views.push_back(static_cast<int>(v));
+  run.images = &images;
+  const DepthRunSummary summary = controller.Run(run, &workspace, nullptr);
+  EXPECT_TRUE(summary.failures.empty());
   PooledDepthMetrics offline;
   for (size_t v = 0; v < scene.views.size(); ++v) {
-    DepthMap m = raw[v];
-    m.depth = raw[v].depth.clone();
-    std::vector<const DepthMap*> neighbors;
-    for (int n : raw[v].neighbors) neighbors.push_back(&raw[n]);
-    ConsistencyStats stats;
-    FilterByConsistency(&m, neighbors, mvs.consistency, &stats);
-    offline.Add(EvaluateDepth(m.depth, m.camera, p.scene.depth[v],
+    const auto m =
+        workspace.Read(DepthWorkspace::Stage::kFinal, static_cast<int>(v));
+    offline.Add(EvaluateDepth(m->depth, m->camera, p.scene.depth[v],
                               p.bag.view_cameras[v]));
   }
   std::printf(
@@ -507,9 +511,12 @@ TEST_F(RealBag, FinalRevisionsAreAsAccurateAsTheOfflinePipeline) {
       100 * first.off5pc(), live.coverage(), live.within1(),
       100 * live.off5pc(), offline.coverage(), offline.within1(),
       100 * offline.off5pc());
+  // The live targets: at most 0.03 less coverage and 0.01 less within 1 %
+  // than offline, at most 1.5 % off by more than 5 % (mono and JPEG inputs
+  // against the offline run on the colour images included).
   EXPECT_GT(live.within1(), offline.within1() - 0.01);
-  EXPECT_LT(live.off5pc(), offline.off5pc() + 0.005);
-  EXPECT_GT(live.coverage(), offline.coverage() - 0.1);
+  EXPECT_LT(live.off5pc(), 0.015);
+  EXPECT_GT(live.coverage(), offline.coverage() - 0.03);
 }
 
 TEST_F(RealBag, LingeringFramesGiveOneKeyframePerView) {

@@ -17,6 +17,7 @@
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/core/stats.h"
 #include "wild_mvs/core/thread_pool.h"
+#include "wild_mvs/pipeline/file_workspace.h"  // ViewOutputsComplete
 
 namespace wild_mvs {
 namespace cli {
@@ -46,9 +47,6 @@ struct DepthStageResult {
   double seconds = 0;
   std::vector<std::string> failures;  // "view: problem"
 };
-// True when view `stem`'s files in `out` are complete (depth, camera and
-// log written; the camera file is written after the maps, the log last).
-bool ViewOutputsComplete(const std::string& out, const std::string& stem);
 // Depth maps of `views` (in order): skips complete views unless `force`,
 // writes depth/normal/confidence/cameras/preview files and log/S.json. A
 // view that fails (bad image, ...) is reported in `failures` and the others
@@ -66,22 +64,8 @@ struct FilterStageResult {
   long long samples = 0, kept = 0;
   std::vector<std::string> failures;
 };
-// The geometric-consistency filter (GeometricConsistencyOptions) of `views`:
-// reads each view's map and its neighbours' maps from `raw` (a folder in the
-// layout of depth_map_io.h, with log/S.json), writes the filtered map and
-// its log (with a "consistency" member) to `out`. Views run in parallel on
-// `pool` (may be null); files are written in order, atomically.
-// `member`: the log's key for the filter's counts.
-FilterStageResult FilterDepthMaps(const Scene& scene,
-                                  const std::vector<int>& views,
-                                  const GeometricConsistencyOptions& options,
-                                  const std::string& raw,
-                                  const std::string& out, ThreadPool* pool,
-                                  std::ostream& log,
-                                  const std::string& member = "consistency");
-
 // The views of `scene` with a complete raw map in OUT/raw but no complete
-// final map in OUT (left by --shard runs), filtered (FilterDepthMaps) into
+// final map in OUT (left by --shard runs), filtered (DepthController) into
 // OUT; nothing when the filter is off (AblationOptions::consistency). Throws
 // Error listing the views that failed.
 FilterStageResult FilterPendingViews(const Scene& scene, const MvsOptions& mvs,

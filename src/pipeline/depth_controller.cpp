@@ -1,0 +1,186 @@
+// Copyright wild_mvs authors.
+#include "wild_mvs/pipeline/depth_controller.h"
+
+#include <algorithm>
+#include <memory>
+
+#include "wild_mvs/core/error.h"
+#include "wild_mvs/core/geometric_consistency.h"
+#include "wild_mvs/core/stats.h"
+
+namespace wild_mvs {
+
+using Stage = DepthWorkspace::Stage;
+using Step = DepthRunObserver::Step;
+
+DepthController::DepthController(const MvsOptions& options, ThreadPool* pool,
+                                 const std::atomic<bool>* cancel)
+    : options_(options), pool_(pool), cancel_(cancel) {}
+
+ViewResult DepthController::Match(const ViewProblem& problem) const {
+  Require(problem.scene && problem.images, "a view problem needs a scene",
+          " and its images");
+  ViewResult r;
+  r.map = ReconstructView(*problem.scene, problem.ref, *problem.images,
+                          options_, pool_, &r.report, problem.mask,
+                          problem.points_per_view, cancel_);
+  return r;
+}
+
+ViewResult DepthController::Filter(const DepthMap& raw,
+                                   const DepthWorkspace& workspace) const {
+  ViewResult r;
+  r.map = raw;  // the arrays may be shared with the workspace: copied
+  r.map.depth = raw.depth.clone();
+  r.map.normal = raw.normal.clone();
+  r.map.confidence = raw.confidence.clone();
+  std::vector<std::shared_ptr<const DepthMap>> held;
+  for (int n : raw.neighbors) {
+    if (n != raw.view && workspace.Has(Stage::kRaw, n))
+      held.push_back(workspace.Read(Stage::kRaw, n));
+  }
+  std::vector<const DepthMap*> neighbors;
+  for (const auto& m : held) neighbors.push_back(m.get());
+  FilterByConsistency(&r.map, neighbors, options_.consistency, &r.consistency);
+  r.filtered = true;
+  r.neighbor_maps = static_cast<int>(neighbors.size());
+  return r;
+}
+
+DepthRunSummary DepthController::Run(const DepthRun& run,
+                                     DepthWorkspace* workspace,
+                                     DepthRunObserver* observer) const {
+  Require(run.scene && run.images && workspace, "a depth run needs a scene,",
+          " its images and a workspace");
+  DepthRunObserver quiet;
+  DepthRunObserver& obs = observer ? *observer : quiet;
+  const Scene& scene = *run.scene;
+  const bool filter = filters();
+  DepthRunSummary s;
+  std::vector<int> to_filter;
+  // Once for the run, not per view (it grows with the collection).
+  const std::vector<std::vector<int>> points_per_view = scene.PointsPerView();
+  const int total = static_cast<int>(run.views.size());
+  obs.StepBegins(Step::kMatch, total);
+  for (int k = 0; k < total; ++k) {
+    const int v = run.views[k];
+    if (!run.force && workspace->Has(Stage::kFinal, v)) {
+      const long long samples = workspace->Samples(Stage::kFinal, v);
+      if (samples > 0) s.samples += samples;
+      ++s.skipped;
+      obs.Skipped(k, v, Stage::kFinal, samples);
+      continue;
+    }
+    if (filter && !run.force && workspace->Has(Stage::kRaw, v)) {
+      to_filter.push_back(v);
+      long long samples = -1;
+      if (!run.filter_now) {  // a shard: resumed, its raw samples counted
+        samples = workspace->Samples(Stage::kRaw, v);
+        if (samples > 0) s.samples += samples;
+        ++s.skipped;
+      }
+      obs.Skipped(k, v, Stage::kRaw, samples);
+      continue;
+    }
+    obs.Begins(Step::kMatch, k, v);
+    ViewResult result;
+    try {
+      ViewProblem problem;
+      problem.scene = &scene;
+      problem.ref = v;
+      problem.images = run.images;
+      if (run.mask) problem.mask = run.mask(v);
+      problem.points_per_view = &points_per_view;
+      result = Match(problem);
+    } catch (const Error& e) {
+      s.failures.push_back(Msg(scene.views[v].name, ": ", e.what()));
+      obs.Failed(Step::kMatch, k, v, e.what());
+      continue;
+    }
+    // Output errors (unwritable folder, full disk) abort the run; every
+    // write is complete or absent, so a view is either done or redone.
+    workspace->Write(Stage::kRaw, v, result);
+    ++s.matched;
+    if (filter) to_filter.push_back(v);
+    if (!filter || !run.filter_now) s.samples += result.map.CountValid();
+    obs.Done(Step::kMatch, k, v, result);
+  }
+  obs.StepEnds(Step::kMatch);
+  ReleaseFreeMemory();  // the steps' peaks do not add up
+  if (!filter) return s;
+  if (!run.filter_now) {
+    s.unfiltered = static_cast<int>(to_filter.size());
+    return s;
+  }
+  if (to_filter.empty()) return s;
+  DepthRun filter_run = run;
+  filter_run.views = to_filter;
+  const DepthRunSummary f = FilterViews(filter_run, workspace, observer);
+  ReleaseFreeMemory();
+  s.filtered = f.filtered;
+  s.samples += f.samples;
+  s.filter_samples = f.filter_samples;
+  s.filter_kept = f.filter_kept;
+  for (const std::string& e : f.failures) s.failures.push_back(e);
+  return s;
+}
+
+DepthRunSummary DepthController::FilterViews(const DepthRun& run,
+                                             DepthWorkspace* workspace,
+                                             DepthRunObserver* observer) const {
+  Require(run.scene && workspace, "a filter run needs a scene and a workspace");
+  options_.consistency.Check();
+  DepthRunObserver quiet;
+  DepthRunObserver& obs = observer ? *observer : quiet;
+  DepthRunSummary s;
+  const int total = static_cast<int>(run.views.size());
+  struct Job {
+    ViewResult result;
+    std::string error;
+  };
+  std::vector<Job> jobs(run.views.size());
+  obs.StepBegins(Step::kFilter, total);
+  // One view per task: each reads its raw map and its neighbours' (read
+  // again by every view that needs them: memory stays bounded by threads x
+  // neighbours).
+  auto filter_one = [&](int k) {
+    Job& job = jobs[k];
+    try {
+      const auto raw = workspace->Read(Stage::kRaw, run.views[k]);
+      job.result = Filter(*raw, *workspace);
+    } catch (const Error& e) {
+      job.error = e.what();
+    }
+  };
+  const int chunk = pool_ ? std::max(1, pool_->size()) : 1;
+  for (int k0 = 0; k0 < total; k0 += chunk) {
+    const int n = std::min(chunk, total - k0);
+    if (pool_ && n > 1) {
+      pool_->ParallelFor(n, [&](int i) { filter_one(k0 + i); });
+    } else {
+      for (int i = 0; i < n; ++i) filter_one(k0 + i);
+    }
+    // Written in order by this thread.
+    for (int k = k0; k < k0 + n; ++k) {
+      const int v = run.views[k];
+      Job& job = jobs[k];
+      obs.Begins(Step::kFilter, k, v);
+      if (!job.error.empty()) {
+        s.failures.push_back(Msg(run.scene->views[v].name, ": ", job.error));
+        obs.Failed(Step::kFilter, k, v, job.error);
+        continue;
+      }
+      workspace->Write(Stage::kFinal, v, job.result);
+      ++s.filtered;
+      s.samples += job.result.consistency.kept;
+      s.filter_samples += job.result.consistency.samples;
+      s.filter_kept += job.result.consistency.kept;
+      obs.Done(Step::kFilter, k, v, job.result);
+      job = Job();
+    }
+  }
+  obs.StepEnds(Step::kFilter);
+  return s;
+}
+
+}  // namespace wild_mvs
