@@ -374,11 +374,17 @@ def main():
                "depth node published (its first revisions, and its final revisions: "
                "matched again with neighbours on both sides, then the consistency "
                "step) and the saved fused cloud, against the ground truth. Views = "
-               "views with a depth map; CPU-s of the live run include ROS.", ""]
+               "views with a depth map; CPU-s of the live run include ROS. First "
+               "depth s: from an image to its keyframe's first depth view (median / "
+               "max, the bag's clock); revised after: how many newer keyframes got "
+               "their first depth view before a keyframe's final revision (median / "
+               "max).", ""]
         md += [table(["scene", "seed", "run", "views", "coverage", "within 1 %",
-                      "off > 5 %", "F 1 cm", "F 5 cm", "CPU-s"],
+                      "off > 5 %", "F 1 cm", "F 5 cm", "CPU-s", "first depth s",
+                      "revised after"],
                      [[r["scene"], r["seed"], r["run"], r["views"], r["coverage"],
-                       r["in1%"], r["off>5%"], r["F@1cm"], r["F@5cm"], r["cpu_s"]]
+                       r["in1%"], r["off>5%"], r["F@1cm"], r["F@5cm"], r["cpu_s"],
+                       r.get("first_s", "-"), r.get("revised_after", "-")]
                       for r in live]), ""]
         by = {(r["scene"], r["run"]): r for r in live}
         cells = []

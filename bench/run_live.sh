@@ -10,16 +10,23 @@
 #
 #   bench/run_live.sh [--families "relief courtyard"] [--seeds 101]
 #                     [--size 640] [--rate 1] [--out DIR] [--skip-build]
-#                     [--sparse tracker|topic]
+#                     [--sparse tracker|topic] [--robot]
 #
 # --sparse: where the depth node's sparse points come from: its own
 # incremental tracker (default, as a robot runs it), or the dataset's
 # sparse model written into the bag (/sparse_points, sparse_source:=topic),
 # the points the offline run uses: then the two differ only in the pipeline.
+# --robot: the bag as a robot records it (`to-bag --frames-per-view 3
+# --body-frame base_link --start-time EPOCH`): a 30 Hz camera lingering 3
+# frames on each view, epoch stamps, /tf world -> base_link at 100 Hz and the
+# camera extrinsic on /tf_static.
 #
 # Needs the ROS build (scripts/common.sh's BUILD_DIR, default build/). Runs
 # its own roscore on a free port. Prints one row per scene and run and
-# writes OUT/live.tsv.
+# writes OUT/live.tsv; first_s: seconds from an image to its keyframe's
+# first depth view (median/max, the bag's clock), revised_after: newer
+# keyframes that got their first depth view before a keyframe's final
+# revision (median/max).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$ROOT/bench/out/live"
@@ -28,6 +35,7 @@ SEEDS=101
 SIZE=640
 RATE=1
 SPARSE=tracker
+ROBOT=()
 BUILD=missing
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
@@ -38,6 +46,8 @@ while [ $# -gt 0 ]; do
     --rate) RATE="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --sparse) SPARSE="$2"; shift 2 ;;
+    --robot) ROBOT=(--frames-per-view 3 --body-frame base_link
+                    --start-time 1764800000.123456); shift ;;
     --skip-build) BUILD=never; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "run_live.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
@@ -91,7 +101,7 @@ fscore() {  # CLOUD SCENE_DIR -> "F@1cm F@5cm"
 }
 
 TSV="$OUT/live.tsv"
-printf 'scene\tseed\trun\tviews\tcoverage\tin1%%\toff>5%%\tF@1cm\tF@5cm\tcpu_s\n' >"$TSV"
+printf 'scene\tseed\trun\tviews\tcoverage\tin1%%\toff>5%%\tF@1cm\tF@5cm\tcpu_s\tfirst_s\trevised_after\n' >"$TSV"
 for family in $FAMILIES; do
   for seed in ${SEEDS//,/ }; do
     kind=$(kinds_of "$family")
@@ -114,13 +124,13 @@ for family in $FAMILIES; do
     off=$(score "$run/offline" "$scene")
     f=$(fscore "$run/offline/fused.ply" "$scene")
     n=$(ls "$run/offline/depth" | grep -c '\.pfm$')
-    printf '%s\t%s\toffline\t%s/%s\t%s\t%s\t%.1f\n' "$kind" "$seed" "$n" "$nviews" \
+    printf '%s\t%s\toffline\t%s/%s\t%s\t%s\t%.1f\t-\t-\n' "$kind" "$seed" "$n" "$nviews" \
       "${off// /	}" "${f// /	}" "$(echo "$u + $s" | bc)" >>"$TSV"
     # Live.
     points=()
     [ "$SPARSE" = topic ] && points=(--with-points)
     "$BIN/wild_mvs_to_bag" "$scene" "$run/scene.bag" --rate "$RATE" \
-      ${points[@]+"${points[@]}"} >"$run/bag.log" 2>&1
+      ${points[@]+"${points[@]}"} ${ROBOT[@]+"${ROBOT[@]}"} >"$run/bag.log" 2>&1
     roscore -p "$PORT" >"$run/roscore.log" 2>&1 &
     core=$!
     sleep 3
@@ -144,9 +154,17 @@ for family in $FAMILIES; do
       else
         f="- -"
       fi
-      printf '%s\t%s\tlive %s revisions\t%s/%s\t%s\t%s\t%s\n' "$kind" "$seed" \
+      # How late: seconds from an image to its keyframe's first depth view
+      # (median/max), and newer keyframes' first views before its final
+      # revision (median/max).
+      lat=$(sed -n 's/^first depth view after its image: median \([0-9.]*\) s, max \([0-9.]*\) s$/\1 \2/p' \
+        "$run/live_$which.log" | awk '{printf "%.1f/%.1f", $1, $2}')
+      lag=$(sed -n 's/^final revision after \([0-9]*\) newer.* \([0-9]*\) (max).*/\1\/\2/p' \
+        "$run/live_$which.log")
+      if [ "$which" = first ]; then lag=-; else lat=-; fi
+      printf '%s\t%s\tlive %s revisions\t%s/%s\t%s\t%s\t%s\t%s\t%s\n' "$kind" "$seed" \
         "$which" "$n" "$nviews" "${sc// /	}" "${f// /	}" \
-        "$([ "$which" = final ] && echo "$cpu" || echo -)" >>"$TSV"
+        "$([ "$which" = final ] && echo "$cpu" || echo -)" "${lat:--}" "${lag:--}" >>"$TSV"
     done
   done
 done

@@ -10,13 +10,20 @@
 // writes OUT/depth/<stem>.pfm with its camera, as `wild_mvs reconstruct`
 // does. Prints the keyframes, views and revisions found. Exit 1 with a
 // message naming the file on bad input.
+//
+// Also prints how late the maps came, from the bag's record times (the
+// launch's clock: sim time, which the bag plays at its rate): per keyframe
+// the seconds from its image stamp to its first depth view, and how many
+// newer keyframes got their first depth view before its final revision.
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <wild_mvs/DepthView.h>
 
+#include <algorithm>
 #include <iostream>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/io/dataset.h"
@@ -40,6 +47,10 @@ int Run(int argc, char** argv) {
   const Scene scene = LoadDataset(dataset);
 
   std::map<uint64_t, wild_mvs::DepthViewConstPtr> by_stamp;
+  // Per keyframe stamp: record time of its first depth view; order of first
+  // depth views; per keyframe the count of first views before its final.
+  std::map<uint64_t, double> first_at;
+  std::map<uint64_t, int> first_order, final_after;
   int messages = 0, revised = 0;
   rosbag::Bag bag;
   try {
@@ -53,6 +64,13 @@ int Run(int argc, char** argv) {
     ++messages;
     revised += v->revision > 0;
     const uint64_t key = v->header.stamp.toNSec();
+    if (!first_at.count(key)) {
+      first_at[key] = m.getTime().toSec() - v->header.stamp.toSec();
+      first_order[key] = static_cast<int>(first_order.size());
+    }
+    if (v->final_revision)
+      final_after[key] =
+          static_cast<int>(first_order.size()) - 1 - first_order[key];
     auto it = by_stamp.find(key);
     const bool take =
         first ? (v->revision == 0 && it == by_stamp.end())
@@ -80,6 +98,22 @@ int Run(int argc, char** argv) {
     }
     WriteDepthMapFiles(out, scene.views[best].Stem(), map, {}, false);
     ++written;
+  }
+  std::vector<double> lat;
+  for (const auto& [k, t] : first_at) lat.push_back(t);
+  std::sort(lat.begin(), lat.end());
+  std::vector<int> lag;
+  for (const auto& [k, n] : final_after) lag.push_back(n);
+  std::sort(lag.begin(), lag.end());
+  if (!lat.empty()) {
+    std::cout << "first depth view after its image: median "
+              << lat[lat.size() / 2] << " s, max " << lat.back() << " s\n";
+  }
+  if (!lag.empty()) {
+    std::cout << "final revision after " << lag[lag.size() / 2]
+              << " newer keyframes' first views (median), " << lag.back()
+              << " (max); " << lag.size() << " of " << first_at.size()
+              << " keyframes have a final revision\n";
   }
   std::cout << messages << " depth views (" << revised << " revisions), "
             << by_stamp.size() << " keyframes, " << written << " of "

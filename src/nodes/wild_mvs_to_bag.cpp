@@ -26,7 +26,9 @@ const char* kUsage =
     "usage: wild_mvs to-bag DATASET OUT.bag [--rate HZ] [--with-points]\n"
     "                       [--world-frame NAME] [--camera-frame NAME]\n"
     "                       [--max-image-size PX] [--compressed png|jpeg]\n"
-    "                       [--with-pose]\n"
+    "                       [--with-pose] [--frames-per-view N]\n"
+    "                       [--frame-rate HZ] [--body-frame NAME]\n"
+    "                       [--start-time SEC]\n"
     "(the same as wild_mvs_to_bag DATASET OUT.bag ...)\n"
     "Writes the dataset's views as /camera/image_raw (rgb8),\n"
     "/camera/camera_info and /tf (world -> camera optical frame) at HZ\n"
@@ -36,7 +38,14 @@ const char* kUsage =
     "cameras and points scaled), --compressed writes\n"
     "/camera/image_raw/compressed (sensor_msgs/CompressedImage) instead of\n"
     "the raw images, --with-pose also writes /camera/pose\n"
-    "(geometry_msgs/PoseStamped, the same pose as /tf).\n";
+    "(geometry_msgs/PoseStamped, the same pose as /tf).\n"
+    "As a robot records: --frames-per-view N frames of each view, "
+    "--frame-rate\n"
+    "HZ apart (default 30; same image and pose, distinct stamps), "
+    "--body-frame\n"
+    "NAME puts /tf world -> NAME at 100 Hz and a latched /tf_static NAME ->\n"
+    "camera optical frame instead of /tf world -> camera, --start-time SEC\n"
+    "the first stamp (default 1000; e.g. an epoch time).\n";
 
 wild_mvs::Scene Load(const std::string& dir) {
 #ifdef WILD_MVS_HAVE_DATASET
@@ -84,6 +93,15 @@ int main(int argc, char** argv) {
         options.compression = value();
       } else if (a == "--with-pose") {
         options.with_pose = true;
+      } else if (a == "--frames-per-view") {
+        options.frames_per_view = static_cast<int>(ParseDouble(a, value()));
+      } else if (a == "--frame-rate") {
+        options.frame_rate = ParseDouble(a, value());
+      } else if (a == "--body-frame") {
+        options.body_frame = value();
+        wild_mvs::Require(!options.body_frame.empty(), a, " needs a name");
+      } else if (a == "--start-time") {
+        options.start_time = ParseDouble(a, value());
       } else if (a == "--world-frame") {
         options.world_frame = value();
       } else if (a == "--camera-frame") {
@@ -141,11 +159,14 @@ int main(int argc, char** argv) {
           return out8;
         },
         out, options);
-    std::printf("wrote %s: %zu frames %dx%d at %.3g Hz%s (%s)\n", out.c_str(),
-                scene.views.size(), scene.views[0].camera.width,
-                scene.views[0].camera.height, options.rate,
-                options.with_points ? " with sparse points" : "",
-                scene.source.c_str());
+    std::printf(
+        "wrote %s: %zu views %dx%d at %.3g Hz, %d frame%s each%s%s (%s)\n",
+        out.c_str(), scene.views.size(), scene.views[0].camera.width,
+        scene.views[0].camera.height, options.rate, options.frames_per_view,
+        options.frames_per_view == 1 ? "" : "s",
+        options.body_frame.empty() ? ""
+                                   : (", /tf of " + options.body_frame).c_str(),
+        options.with_points ? ", sparse points" : "", scene.source.c_str());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "wild_mvs_to_bag: error: %s\n", e.what());

@@ -6,8 +6,10 @@
 # encoding and pixels, camera_info K (core -> ROS pixel convention: c - 0.5)
 # and /tf and /camera/pose (camera centre and orientation) against the
 # dataset's cameras.txt / images.txt; /sparse_points with --with-points.
-# Then --compressed png (lossless: the same pixels) and --max-image-size
-# (K scaled).
+# Then --compressed png (lossless: the same pixels), --max-image-size
+# (K scaled), and a bag as a robot records it (--frames-per-view,
+# --body-frame, --start-time: lingering frames, /tf of the body at 100 Hz,
+# /tf_static of the camera).
 #   test/ros/test_to_bag.sh WILD_MVS MAKE_SCENE DEVEL_DIR
 set -eo pipefail
 CLI=${1:?usage: test_to_bag.sh WILD_MVS MAKE_SCENE DEVEL_DIR}
@@ -28,6 +30,14 @@ fail() { echo "FAIL: $*" >&2; for f in "$TMP"/*.log; do [ -f "$f" ] && { echo "-
   fail "to-bag --compressed png"
 "$CLI" to-bag "$TMP/ds" "$TMP/small.bag" --max-image-size 48 >"$TMP/small.log" 2>&1 ||
   fail "to-bag --max-image-size 48"
+"$CLI" to-bag "$TMP/ds" "$TMP/robot.bag" --rate 1 --frames-per-view 3 \
+  --body-frame base_link --start-time 1764800000.25 >"$TMP/robot.log" 2>&1 ||
+  fail "to-bag as a robot records"
+if "$CLI" to-bag "$TMP/ds" "$TMP/bad2.bag" --rate 20 --frames-per-view 3 \
+  >"$TMP/bad2.log" 2>&1; then
+  fail "to-bag: 3 frames at 30 Hz between views at 20 Hz succeeded"
+fi
+grep -q "do not fit between views" "$TMP/bad2.log" || fail "no reason for --frames-per-view"
 # A bad argument is an error, not a bag.
 if "$CLI" to-bag "$TMP/ds" "$TMP/bad.bag" --rate 0 >"$TMP/bad.log" 2>&1; then
   fail "to-bag --rate 0 succeeded"
@@ -219,6 +229,54 @@ for i, v in enumerate(views):
           "small size %dx%d" % (info.width, info.height))
     K = [c["fx"] * s, 0, c["cx"] * s - 0.5, 0, c["fy"] * s, c["cy"] * s - 0.5, 0, 0, 1]
     check(np.allclose(info.K, K, atol=1e-6), "small K %s vs %s" % (list(info.K), K))
+
+# As a robot records: 3 frames of each view at 30 Hz, /tf world -> base_link
+# at 100 Hz, one latched /tf_static base_link -> camera; tf at every image
+# stamp (the samples beside it composed with the static transform) is the
+# view's camera pose.
+robot = by_topic(os.path.join(tmp, "robot.bag"))
+check(sorted(robot) == ["/camera/camera_info", "/camera/image_raw", "/tf", "/tf_static"],
+      "robot topics %s" % sorted(robot))
+imgs = robot["/camera/image_raw"]
+check(len(imgs) == 12, "robot images %d" % len(imgs))
+st = robot["/tf_static"]
+check(len(st) == 1 and len(st[0][0].transforms) == 1, "one /tf_static")
+S = st[0][0].transforms[0]
+check(S.header.frame_id == "base_link" and S.child_frame_id == "camera_optical_frame",
+      "static frames %s -> %s" % (S.header.frame_id, S.child_frame_id))
+conn = [c for c in rosbag.Bag(os.path.join(tmp, "robot.bag"))._connections.values()
+        if c.topic == "/tf_static"]
+check(conn and conn[0].header.get("latching") in ("1", b"1"), "/tf_static not latched")
+tfs = sorted((T.header.stamp.to_sec(), T) for m, _ in robot["/tf"] for T in m.transforms)
+check(all(T.header.frame_id == "map" or T.header.frame_id == "world" for _, T in tfs), "tf parent")
+check(all(T.child_frame_id == "base_link" for _, T in tfs), "tf child")
+gaps = np.diff([s for s, _ in tfs])
+check(np.allclose(gaps, 0.01, atol=1e-6), "tf not at 100 Hz")
+
+
+def mat(tr):
+    q = tr.rotation
+    M = np.eye(4)
+    M[:3, :3] = rot([q.w, q.x, q.y, q.z])
+    M[:3, 3] = [tr.translation.x, tr.translation.y, tr.translation.z]
+    return M
+
+
+body_cam = mat(S.transform)
+for k, (img, t) in enumerate(imgs):
+    i, j = divmod(k, 3)
+    stamp = 1764800000.25 + i + j / 30.0
+    check(abs(img.header.stamp.to_sec() - stamp) < 1e-5, "robot image %d stamp %.6f" %
+          (k, img.header.stamp.to_sec()))
+    # The tf samples on both sides of the stamp (tf2 interpolates them).
+    before = max((s, T) for s, T in tfs if s <= stamp + 1e-9)[1]
+    after = min((s, T) for s, T in tfs if s >= stamp - 1e-9)[1]
+    v = views[i]
+    R = rot(v["q"])
+    for T in (before, after):
+        W = mat(T.transform) @ body_cam  # world_T_camera
+        check(np.allclose(W[:3, 3], -R.T @ v["t"], atol=1e-6) and
+              np.allclose(W[:3, :3], R.T, atol=1e-6), "robot tf at image %d" % k)
 
 if errors:
     print("\n".join(errors[:30]))

@@ -16,6 +16,15 @@
 //   /sparse_points       wild_mvs/SparsePoints (with_points): the scene's
 //                        points seen by >= 2 of the views so far, with their
 //                        observations by stamp (ROS pixel convention)
+//
+// As a robot records (frames_per_view > 1, body_frame set): the camera
+// lingers on each view for frames_per_view frames frame_rate apart (same
+// image and pose, distinct stamps, all before the next view), and /tf
+// carries world_frame -> body_frame at tf_rate, with one latched /tf_static
+// body_frame -> camera_frame (x forward, z up body to z forward, y down
+// optical, plus extrinsic_translation); the /tf samples take the pose of
+// the view whose frames are nearest in time, so tf interpolation at an
+// image stamp gives that view's pose exactly.
 #pragma once
 
 #include <functional>
@@ -40,6 +49,13 @@ struct SceneBagOptions {
   int jpeg_quality = 95;
   bool with_pose = false;  // also write pose_topic (PoseStamped)
   std::string pose_topic = "/camera/pose";
+  int frames_per_view = 1;   // frames of each view, >= 1
+  double frame_rate = 30.0;  // Hz between the frames of one view
+  // "" = /tf world_frame -> camera_frame with each frame; else the body
+  // frame of /tf (at tf_rate Hz) and /tf_static (body -> camera).
+  std::string body_frame;
+  double tf_rate = 100.0;  // Hz, with body_frame
+  double extrinsic_translation[3] = {0.08, -0.025, 0.04};  // m, body frame
   void Check() const;
 };
 
