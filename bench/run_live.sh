@@ -16,6 +16,9 @@
 # incremental tracker (default, as a robot runs it), or the dataset's
 # sparse model written into the bag (/sparse_points, sparse_source:=topic),
 # the points the offline run uses: then the two differ only in the pipeline.
+# With the tracker, the offline tool also runs on the images without the
+# dataset's points ("offline, own tracks": it computes its own SIFT tracks,
+# as the live tracker does).
 # --robot: the bag as a robot records it (`to-bag --frames-per-view 3
 # --body-frame base_link --start-time EPOCH`): a 30 Hz camera lingering 3
 # frames on each view, epoch stamps, /tf world -> base_link at 100 Hz and the
@@ -126,6 +129,30 @@ for family in $FAMILIES; do
     n=$(ls "$run/offline/depth" | grep -c '\.pfm$')
     printf '%s\t%s\toffline\t%s/%s\t%s\t%s\t%.1f\t-\t-\n' "$kind" "$seed" "$n" "$nviews" \
       "${off// /	}" "${f// /	}" "$(echo "$u + $s" | bc)" >>"$TSV"
+    # Offline on the same images without the dataset's sparse points: the
+    # tool computes its own tracks (SIFT), as the live tracker does.
+    if [ "$SPARSE" = tracker ]; then
+      bare="$OUT/scenes/${kind}_s${seed}_${SIZE}_no_points"
+      if [ ! -f "$bare/sparse/points3D.txt" ]; then
+        rm -rf "$bare"
+        mkdir -p "$bare/sparse"
+        cp -r "$scene/images" "$bare/images"
+        cp "$scene/sparse/cameras.txt" "$bare/sparse/"
+        # images.txt without its observations, no points.
+        awk '/^#/ {print; next} {n++; print (n % 2 ? $0 : "")}' \
+          "$scene/sparse/images.txt" >"$bare/sparse/images.txt"
+        echo "# no points" >"$bare/sparse/points3D.txt"
+      fi
+      /usr/bin/time -f '%U %S' -o "$run/offline_own.time" \
+        "$BIN/wild_mvs" reconstruct "$bare" "$run/offline_own" --threads 2 \
+        --stages sparse,depth,fuse,mesh >"$run/offline_own.log" 2>&1
+      read -r u s <"$run/offline_own.time"
+      off=$(score "$run/offline_own" "$scene")
+      f=$(fscore "$run/offline_own/fused.ply" "$scene")
+      n=$(ls "$run/offline_own/depth" | grep -c '\.pfm$')
+      printf '%s\t%s\toffline, own tracks\t%s/%s\t%s\t%s\t%.1f\t-\t-\n' "$kind" "$seed" \
+        "$n" "$nviews" "${off// /	}" "${f// /	}" "$(echo "$u + $s" | bc)" >>"$TSV"
+    fi
     # Live.
     points=()
     [ "$SPARSE" = topic ] && points=(--with-points)

@@ -17,6 +17,8 @@
 #include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/image_files.h"
 #include "wild_mvs/io/ply.h"
+#include "wild_mvs/pipeline/depth_controller.h"
+#include "wild_mvs/pipeline/file_workspace.h"
 
 namespace wild_mvs {
 namespace cli {
@@ -52,6 +54,30 @@ class SilenceStdout {
   int saved_ = -1;
 };
 
+// The fusion's progress: a bar on a terminal, nothing per view in logs.
+class FuseProgress : public DepthRunObserver {
+ public:
+  FuseProgress(const Scene& scene, std::ostream& log)
+      : scene_(scene), log_(log) {}
+  void StepBegins(Step, int total) override {
+    progress_ =
+        std::make_unique<Progress>("fuse", total, log_, StderrIsTerminal());
+  }
+  void StepEnds(Step) override {
+    progress_->Finish();
+    progress_.reset();
+  }
+  void Begins(Step, int, int key) override {
+    progress_->Begin(scene_.views[key].Stem());
+  }
+  void Done(Step, int, int, const ViewResult&) override { progress_->End(""); }
+
+ private:
+  const Scene& scene_;
+  std::ostream& log_;
+  std::unique_ptr<Progress> progress_;
+};
+
 }  // namespace
 
 PointCloud LoadFusedCloud(const std::string& path) {
@@ -63,57 +89,42 @@ FuseResult RunFuseStage(const Scene& scene, ImageCache* images,
                         const std::string& out, const std::string& ply,
                         std::ostream& log, PointCloud* cloud_out) {
   const auto t0 = Clock::now();
-  std::vector<int> views;
+  const DepthController controller(config.mvs, pool);
+  // The final maps: OUT (filtered or not).
+  const FileDepthWorkspace workspace(scene, out, false);
+  DepthRun run;
+  run.scene = &scene;
   for (size_t i = 0; i < scene.views.size(); ++i) {
-    if (DepthMapFilesExist(out, scene.views[i].Stem())) {
-      views.push_back(static_cast<int>(i));
-    }
+    if (workspace.Has(DepthWorkspace::Stage::kFinal, static_cast<int>(i)))
+      run.views.push_back(static_cast<int>(i));
   }
-  Require(!views.empty(), out,
-          ": no depth maps of this dataset's views (expected depth/S.pfm and "
-          "cameras/S.txt, e.g. S = ",
+  Require(!run.views.empty(), out,
+          ": no depth maps of this dataset's views (expected depth/S.pfm, "
+          "cameras/S.txt and log/S.json, e.g. S = ",
           scene.views.empty() ? "?" : scene.views[0].Stem(),
           "); run 'wild_mvs reconstruct' first");
-  Progress progress("fuse", static_cast<int>(views.size()), log,
-                    StderrIsTerminal());
-  DepthMapProvider depth = [&](int v) {
-    return std::make_shared<const DepthMap>(
-        ReadDepthMapFiles(out, scene.views[v].Stem(), scene));
-  };
-  // Fusion reads each view's image once (its samples' colours), so the
-  // images cached for the earlier stages go and the fusion's own are not
-  // cached: its memory depends neither on image.cache_mb nor on how much of
-  // the collection that cache held.
-  ImageProvider image;
-  if (images) {
-    images->Clear();
-    ReleaseFreeMemory();
-    image = [images](int v) { return images->Load(v); };
-  }
-  MaskProvider mask = [&](int v) { return LoadViewMask(scene.views[v]); };
-  StreamingFusion fusion(config.fusion, depth, image, mask, pool);
-  for (int v : views) {
-    progress.Begin(scene.views[v].Stem());
-    fusion.AddView(v);
-    progress.End("");
-  }
-  progress.Finish();
-  // Only the cloud is left to use: the maps and pending samples go first,
-  // and without a caller that needs the cloud it is written in chunks
-  // rather than copied whole.
-  fusion.Finish();
-  const FusionStats& st = fusion.stats();
-  if (cloud_out) {
-    *cloud_out = fusion.Cloud();
-    WritePly(ply, *cloud_out);
-  } else {
-    WritePlyChunked(ply, fusion.num_points(), [&](size_t begin, size_t end) {
-      return fusion.Cloud(begin, end);
-    });
-  }
+  run.images = images;
+  run.mask = [&scene](int v) { return LoadViewMask(scene.views[v]); };
+  FuseProgress progress(scene, log);
   FuseResult r;
-  r.views = static_cast<int>(views.size());
-  r.points = fusion.num_points();
+  FusionStats st;
+  r.views =
+      controller.Fuse(run, config.fusion, workspace, &progress,
+                      [&](const StreamingFusion& fusion) {
+                        // Without a caller that needs the cloud it is written
+                        // in chunks rather than copied whole.
+                        if (cloud_out) {
+                          *cloud_out = fusion.Cloud();
+                          WritePly(ply, *cloud_out);
+                        } else {
+                          WritePlyChunked(ply, fusion.num_points(),
+                                          [&](size_t begin, size_t end) {
+                                            return fusion.Cloud(begin, end);
+                                          });
+                        }
+                        r.points = fusion.num_points();
+                        st = fusion.stats();
+                      });
   r.seconds = SecondsSince(t0);
   log << "fuse: " << r.views << " depth maps, " << st.samples << " samples, "
       << st.accepted << " consistent -> " << r.points << " points, peak "

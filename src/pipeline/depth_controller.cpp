@@ -183,4 +183,46 @@ DepthRunSummary DepthController::FilterViews(const DepthRun& run,
   return s;
 }
 
+int DepthController::Fuse(
+    const DepthRun& run, const FusionOptions& options,
+    const DepthWorkspace& workspace, DepthRunObserver* observer,
+    const std::function<void(const StreamingFusion&)>& done) const {
+  Require(run.scene, "a fusion run needs a scene");
+  DepthRunObserver quiet;
+  DepthRunObserver& obs = observer ? *observer : quiet;
+  std::vector<int> views;
+  for (int v : run.views)
+    if (workspace.Has(Stage::kFinal, v)) views.push_back(v);
+  Require(!views.empty(), "no depth map of this dataset's views");
+  DepthMapProvider depth = [&workspace](int v) {
+    return workspace.Read(Stage::kFinal, v);
+  };
+  // Fusion reads each view's image once (its samples' colours), so the
+  // images cached for the earlier steps go and the fusion's own are not
+  // cached: its memory depends neither on the cache's budget nor on how
+  // much of the collection that cache held.
+  ImageProvider image;
+  if (run.images) {
+    run.images->Clear();
+    ReleaseFreeMemory();
+    ImageCache* images = run.images;
+    image = [images](int v) { return images->Load(v); };
+  }
+  MaskProvider mask;
+  if (run.mask) mask = run.mask;
+  StreamingFusion fusion(options, depth, image, mask, pool_);
+  const int total = static_cast<int>(views.size());
+  obs.StepBegins(Step::kFuse, total);
+  for (int k = 0; k < total; ++k) {
+    obs.Begins(Step::kFuse, k, views[k]);
+    fusion.AddView(views[k]);
+    obs.Done(Step::kFuse, k, views[k], ViewResult());
+  }
+  obs.StepEnds(Step::kFuse);
+  // Only the cloud is left to use: the maps and pending samples go first.
+  fusion.Finish();
+  if (done) done(fusion);
+  return total;
+}
+
 }  // namespace wild_mvs

@@ -3,7 +3,8 @@
 // offline run over a folder writes matched and filtered maps that match
 // the ground truth, resumes without redoing anything, and a sharded run
 // filtered later gives the same maps; the live path's steps over an
-// in-memory workspace give the offline maps.
+// in-memory workspace give the offline maps; the fused cloud lies on the
+// true surfaces and is the same from files or from memory.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -216,6 +217,61 @@ TEST(DepthController, FilterChecksOnlyAgainstMapsTheWorkspaceHolds) {
   const ViewResult alone = controller.Filter(matched.map, empty);
   EXPECT_EQ(alone.neighbor_maps, 0);
   EXPECT_EQ(alone.consistency.kept, matched.map.CountValid());
+}
+
+// Fraction of the points that lie on a surface some view sees: projected
+// into a view, within 1 % of its exact depth there.
+double OnTheSurface(const PointCloud& cloud, const SyntheticScene& s) {
+  long long on = 0;
+  for (const Eigen::Vector3f& p : cloud.xyz) {
+    const Eigen::Vector3d X = p.cast<double>();
+    for (size_t v = 0; v < s.scene.views.size(); ++v) {
+      const Camera& c = s.scene.views[v].camera;
+      Eigen::Vector2d px;
+      if (!c.Project(X, &px) || !c.InImage(px)) continue;
+      const int x = std::min(c.width - 1, static_cast<int>(px.x()));
+      const int y = std::min(c.height - 1, static_cast<int>(px.y()));
+      const float g = s.depth[v].at<float>(y, x);
+      if (g > 0 && std::abs(c.Depth(X) - g) <= 0.01 * g) {
+        ++on;
+        break;
+      }
+    }
+  }
+  return cloud.empty() ? 0.0 : static_cast<double>(on) / cloud.size();
+}
+
+TEST(DepthController, FusesTheFinalMapsFromFilesOrMemoryAlike) {
+  const SyntheticScene& s = Scene8();
+  ImageCache images(s.Loader(), 256);
+  const DepthController controller(MvsOptions(), nullptr);
+  const std::string out = TempDir("fuse");
+  FileDepthWorkspace files(s.scene, out, true);
+  DepthRun run = MakeRun(s, &images);
+  controller.Run(run, &files, nullptr);
+  PointCloud from_files;
+  const int n = static_cast<int>(s.scene.views.size());
+  EXPECT_EQ(controller.Fuse(
+                run, FusionOptions(), files, nullptr,
+                [&](const StreamingFusion& f) { from_files = f.Cloud(); }),
+            n);
+  EXPECT_GT(from_files.size(), 1000u);
+  EXPECT_GT(OnTheSurface(from_files, s), 0.97);
+  // The same final maps held in memory (as the live path holds them).
+  MemoryDepthWorkspace memory;
+  for (int v = 0; v < n; ++v)
+    memory.Put(Stage::kFinal, v, files.Read(Stage::kFinal, v));
+  PointCloud from_memory;
+  controller.Fuse(run, FusionOptions(), memory, nullptr,
+                  [&](const StreamingFusion& f) { from_memory = f.Cloud(); });
+  ASSERT_EQ(from_memory.size(), from_files.size());
+  for (size_t i = 0; i < from_files.size(); ++i)
+    ASSERT_EQ(from_memory.xyz[i], from_files.xyz[i]) << "point " << i;
+  // Nothing to fuse is an error, not an empty cloud.
+  MemoryDepthWorkspace empty;
+  EXPECT_THROW(controller.Fuse(run, FusionOptions(), empty, nullptr, nullptr),
+               Error);
+  fs::remove_all(out);
 }
 
 TEST(DepthWorkspace, MissingMapsAreNamedErrors) {

@@ -6,6 +6,8 @@
 //      with MPGC) -> the workspace's raw map of R.
 //   2. Filter: R's raw map checked against its neighbours' raw maps
 //      (FilterByConsistency, docs/ALGORITHM.md 5.3) -> R's final map.
+//   3. Fuse: the final maps merged into one cloud (StreamingFusion, the
+//      class the live fusion node runs too).
 //
 // Offline (`wild_mvs reconstruct`) runs both steps stage by stage over the
 // views of a dataset: Run (resumable; --shard processes only match, and
@@ -21,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "wild_mvs/core/fusion.h"
 #include "wild_mvs/core/image.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/scene.h"
@@ -57,7 +60,7 @@ struct DepthRun {
 class DepthRunObserver {
  public:
   virtual ~DepthRunObserver() = default;
-  enum class Step { kMatch, kFilter };
+  enum class Step { kMatch, kFilter, kFuse };
   // A step over `total` views starts / ends.
   virtual void StepBegins(Step, int /*total*/) {}
   virtual void StepEnds(Step) {}
@@ -110,6 +113,15 @@ class DepthController {
   // parallel on the pool, writing final maps in view order.
   DepthRunSummary FilterViews(const DepthRun& run, DepthWorkspace* workspace,
                               DepthRunObserver* observer) const;
+  // Offline: fuses the final maps the workspace holds of run.views (in
+  // order; views without one are left out: Error when none has one), the
+  // colours from run.images (released first: the fusion reads each image
+  // once, uncached; null = no colours), masks from run.mask; then hands
+  // the finished fusion to `done` (its cloud read whole or in chunks).
+  // Returns the number of views fused.
+  int Fuse(const DepthRun& run, const FusionOptions& options,
+           const DepthWorkspace& workspace, DepthRunObserver* observer,
+           const std::function<void(const StreamingFusion&)>& done) const;
 
  private:
   MvsOptions options_;
