@@ -1,26 +1,17 @@
 // Copyright wild_mvs authors.
 #include "wild_mvs/cli/run_steps.h"
 
-#include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
-#include <map>
 #include <memory>
-#include <regex>
-#include <sstream>
 
 #include "wild_mvs/cli/progress.h"
 #include "wild_mvs/cli/scene_setup.h"
-#include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/reconstruct_view.h"
 #include "wild_mvs/core/sparse_tracker.h"
 #include "wild_mvs/core/stats.h"
-#include "wild_mvs/io/atomic_file.h"
 #include "wild_mvs/io/colmap.h"
-#include "wild_mvs/io/depth_map_io.h"
 #include "wild_mvs/io/image_files.h"
-#include "wild_mvs/io/report_json.h"
 #include "wild_mvs/io/sparse_tracks_file.h"
 #include "wild_mvs/pipeline/depth_controller.h"
 #include "wild_mvs/pipeline/file_workspace.h"

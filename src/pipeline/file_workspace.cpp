@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <regex>
 #include <sstream>
 
@@ -83,9 +82,10 @@ bool ViewOutputsComplete(const std::string& dir, const std::string& stem) {
 
 FileDepthWorkspace::FileDepthWorkspace(const Scene& scene, std::string out,
                                        bool filter)
-    : scene_(scene),
-      out_(std::move(out)),
-      raw_(filter ? out_ + "/raw" : out_) {}
+    : scene_(scene), out_(std::move(out)), raw_(filter ? out_ + "/raw" : out_) {
+  for (size_t i = 0; i < scene_.views.size(); ++i)
+    index_.emplace(scene_.views[i].name, static_cast<int>(i));
+}
 
 const std::string& FileDepthWorkspace::Folder(Stage stage) const {
   return stage == Stage::kRaw ? raw_ : out_;
@@ -106,12 +106,8 @@ std::shared_ptr<const DepthMap> FileDepthWorkspace::Read(Stage stage,
   auto map = std::make_shared<DepthMap>(std::move(files.map));
   map->view = key;
   for (const std::string& name : files.neighbor_names) {
-    for (size_t i = 0; i < scene_.views.size(); ++i) {
-      if (scene_.views[i].name == name) {
-        map->neighbors.push_back(static_cast<int>(i));
-        break;
-      }
-    }
+    auto it = index_.find(name);
+    if (it != index_.end()) map->neighbors.push_back(it->second);
   }
   return map;
 }

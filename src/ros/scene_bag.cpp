@@ -47,10 +47,16 @@ void SceneBagOptions::Check() const {
           "tf_rate = ", tf_rate, " must be in (0, 10000] Hz");
 }
 
-namespace {
+Eigen::Matrix3d BodyToOpticalRotation() {
+  Eigen::Matrix3d R;
+  R << 0, 0, 1,  //
+      -1, 0, 0,  //
+      0, -1, 0;
+  return R;
+}
 
-geometry_msgs::Transform TransformOf(const Eigen::Matrix3d& R,
-                                     const Eigen::Vector3d& t) {
+geometry_msgs::Transform TransformMsg(const Eigen::Matrix3d& R,
+                                      const Eigen::Vector3d& t) {
   geometry_msgs::Transform m;
   m.translation.x = t.x();
   m.translation.y = t.y();
@@ -64,7 +70,16 @@ geometry_msgs::Transform TransformOf(const Eigen::Matrix3d& R,
   return m;
 }
 
-}  // namespace
+boost::shared_ptr<ros::M_string> LatchedTfStaticHeader() {
+  const tf2_msgs::TFMessage m;
+  auto h = boost::make_shared<ros::M_string>();
+  (*h)["type"] = ros::message_traits::datatype(m);
+  (*h)["md5sum"] = ros::message_traits::md5sum(m);
+  (*h)["message_definition"] = ros::message_traits::definition(m);
+  (*h)["callerid"] = "/static_transform_publisher";
+  (*h)["latching"] = "1";
+  return h;
+}
 
 cv::Mat LinearToSrgb8(const cv::Mat& linear_rgb) {
   Require(linear_rgb.type() == CV_32FC3, "LinearToSrgb8: expected CV_32FC3");
@@ -104,10 +119,7 @@ void WriteSceneBag(const Scene& scene,
   };
   auto stamp_of = [&](int i) { return frame_stamp(i, 0); };
   const bool body = !options.body_frame.empty();
-  // Body -> optical: columns are the optical axes in the body frame (body x
-  // forward, y left, z up; optical z forward, x right, y down).
-  Eigen::Matrix3d body_R_cam;
-  body_R_cam << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  const Eigen::Matrix3d body_R_cam = BodyToOpticalRotation();
   const Eigen::Vector3d body_t_cam(options.extrinsic_translation[0],
                                    options.extrinsic_translation[1],
                                    options.extrinsic_translation[2]);
@@ -124,16 +136,10 @@ void WriteSceneBag(const Scene& scene,
       S.header.stamp = ros::Time(t0 - 0.001);
       S.header.frame_id = options.body_frame;
       S.child_frame_id = options.camera_frame;
-      S.transform = TransformOf(body_R_cam, body_t_cam);
+      S.transform = TransformMsg(body_R_cam, body_t_cam);
       tf2_msgs::TFMessage st;
       st.transforms.push_back(S);
-      auto latched = boost::make_shared<ros::M_string>();
-      (*latched)["type"] = ros::message_traits::datatype(st);
-      (*latched)["md5sum"] = ros::message_traits::md5sum(st);
-      (*latched)["message_definition"] = ros::message_traits::definition(st);
-      (*latched)["callerid"] = "/static_transform_publisher";
-      (*latched)["latching"] = "1";
-      bag.write("/tf_static", S.header.stamp, st, latched);
+      bag.write("/tf_static", S.header.stamp, st, LatchedTfStaticHeader());
       const double linger = (options.frames_per_view - 1) / options.frame_rate;
       for (long k = 0;; ++k) {
         const double t = t0 + k / options.tf_rate;
@@ -157,7 +163,7 @@ void WriteSceneBag(const Scene& scene,
         T.header.stamp = ros::Time(t);
         T.header.frame_id = options.world_frame;
         T.child_frame_id = options.body_frame;
-        T.transform = TransformOf(world_R_body, world_t_body);
+        T.transform = TransformMsg(world_R_body, world_t_body);
         tf2_msgs::TFMessage tf;
         tf.transforms.push_back(T);
         bag.write("/tf", T.header.stamp, tf);

@@ -129,29 +129,10 @@ struct RealWorldBag {
   std::map<uint64_t, int> view_by_nsec_, frame_by_nsec_;
 };
 
-// The usual body -> camera optical frame rotation (REP 103: body x forward,
-// y left, z up; optical z forward, x right, y down): columns are the optical
-// axes in the body frame.
-inline Eigen::Matrix3d BodyToOpticalRotation() {
-  Eigen::Matrix3d R;
-  R << 0, 0, 1,  //
-      -1, 0, 0,  //
-      0, -1, 0;
-  return R;
-}
+using ros1::BodyToOpticalRotation;
 
 inline geometry_msgs::Transform TransformMsg(const Eigen::Isometry3d& T) {
-  geometry_msgs::Transform m;
-  m.translation.x = T.translation().x();
-  m.translation.y = T.translation().y();
-  m.translation.z = T.translation().z();
-  Eigen::Quaterniond q(T.rotation());
-  q.normalize();
-  m.rotation.x = q.x();
-  m.rotation.y = q.y();
-  m.rotation.z = q.z();
-  m.rotation.w = q.w();
-  return m;
+  return ros1::TransformMsg(T.rotation(), T.translation());
 }
 
 // world_T_camera of a core camera (R, t are world-to-camera).
@@ -177,19 +158,6 @@ inline cv::Mat RealBagImage(const SyntheticScene& scene, int i,
     throw std::invalid_argument("RealBagImage: encoding '" + encoding +
                                 "' is not rgb8, bgr8 or mono8");
   return out;
-}
-
-// A connection header with latching=1 (rosbag play re-publishes such a topic
-// latched, as `rosbag record` stores /tf_static).
-template <typename M>
-boost::shared_ptr<ros::M_string> LatchedConnectionHeader(const M& msg) {
-  auto h = boost::make_shared<ros::M_string>();
-  (*h)["type"] = ros::message_traits::datatype(msg);
-  (*h)["md5sum"] = ros::message_traits::md5sum(msg);
-  (*h)["message_definition"] = ros::message_traits::definition(msg);
-  (*h)["callerid"] = "/static_transform_publisher";
-  (*h)["latching"] = "1";
-  return h;
 }
 
 // Writes the bag of `scene` (every view, in order) to `path`.
@@ -267,7 +235,7 @@ inline RealWorldBag WriteRealWorldBag(const SyntheticScene& scene,
     tf2_msgs::TFMessage m;
     m.transforms.push_back(T);
     bag.write("/tf_static", TimeFromNSec(static_ns), m,
-              LatchedConnectionHeader(m));
+              ros1::LatchedTfStaticHeader());
   }
 
   // Merge /tf samples and camera frames in time order (tf first on ties).

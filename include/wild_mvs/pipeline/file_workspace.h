@@ -9,6 +9,7 @@
 #pragma once
 
 #include <string>
+#include <unordered_map>
 
 #include "wild_mvs/core/scene.h"
 #include "wild_mvs/pipeline/depth_workspace.h"
@@ -37,6 +38,7 @@ class FileDepthWorkspace : public DepthWorkspace {
  private:
   const Scene& scene_;
   std::string out_, raw_;
+  std::unordered_map<std::string, int> index_;  // view name -> key
 };
 
 // True when view `stem`'s files in folder `dir` are complete (maps, camera

@@ -27,6 +27,10 @@
 // image stamp gives that view's pose exactly.
 #pragma once
 
+#include <geometry_msgs/Transform.h>
+#include <ros/datatypes.h>
+
+#include <Eigen/Core>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <string>
@@ -67,6 +71,17 @@ void WriteSceneBag(const Scene& scene,
 
 // Linear RGB float (the core's image type) -> 8-bit sRGB RGB.
 cv::Mat LinearToSrgb8(const cv::Mat& linear_rgb);
+
+// The usual body -> camera optical frame rotation (REP 103: body x forward,
+// y left, z up; optical z forward, x right, y down): columns are the
+// optical axes in the body frame.
+Eigen::Matrix3d BodyToOpticalRotation();
+// The transform of rotation R and translation t (parent <- child).
+geometry_msgs::Transform TransformMsg(const Eigen::Matrix3d& R,
+                                      const Eigen::Vector3d& t);
+// A connection header for /tf_static (tf2_msgs/TFMessage) with latching=1:
+// rosbag play re-publishes it latched, as `rosbag record` stores it.
+boost::shared_ptr<ros::M_string> LatchedTfStaticHeader();
 
 }  // namespace ros1
 }  // namespace wild_mvs
