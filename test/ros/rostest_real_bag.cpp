@@ -234,6 +234,12 @@ class Playback {
   std::map<uint64_t, wild_mvs::DepthViewConstPtr> first_views;  // revision 0
   std::map<uint64_t, sensor_msgs::ImageConstPtr> depth_images;
   std::map<uint64_t, sensor_msgs::PointCloud2ConstPtr> node_points, xyz_points;
+  // Every revision's depth image and node cloud, per stamp, in arrival order
+  // (a revision republishes the stamp; depth_image_proc, pairing image and
+  // camera_info by exact stamp, may make a cloud of either).
+  std::map<uint64_t, std::vector<sensor_msgs::ImageConstPtr>> depth_revisions;
+  std::map<uint64_t, std::vector<sensor_msgs::PointCloud2ConstPtr>>
+      node_points_revisions;
   int confidence_count = 0, info_count = 0;
   std::vector<CloudRx> clouds;
   Clock::time_point last_view_at{};  // arrival of the newest DepthView
@@ -267,6 +273,7 @@ class Playback {
           if (frozen_) return;
           note("/depth_node/depth/image_rect", m->header);
           depth_images[m->header.stamp.toNSec()] = m;
+          depth_revisions[m->header.stamp.toNSec()].push_back(m);
         });
     s_info_ = nh_.subscribe<sensor_msgs::CameraInfo>(
         "/depth_node/depth/camera_info", 50,
@@ -291,6 +298,7 @@ class Playback {
           if (frozen_) return;
           note("/depth_node/points", m->header);
           node_points[m->header.stamp.toNSec()] = m;
+          node_points_revisions[m->header.stamp.toNSec()].push_back(m);
         });
     s_xyz_ = nh_.subscribe<sensor_msgs::PointCloud2>(
         "/xyz/points", 50,
@@ -560,25 +568,37 @@ TEST_F(RealBag, DepthImageProcCloudIsTheNodesOwnCloud) {
         << "no /xyz/points for depth image " << StampStr(img->header.stamp);
     if (xyz == p.xyz_points.end()) continue;
     EXPECT_EQ(xyz->second->header.frame_id, img->header.frame_id);
-    const cv::Mat d = ros1::FloatImageFromMsg(*img, 1, "depth");
-    const int valid = CountFinite(d);
     // point_cloud_xyz: organised, NaN where the depth is NaN.
     PointCloud pc = CloudFromMsg(*xyz->second);
     std::vector<Eigen::Vector3d> finite;
     for (const auto& pt : pc.xyz)
       if (pt.allFinite()) finite.push_back(pt.cast<double>());
+    // The revision of this stamp the cloud was made from (the newest one
+    // when none has as many valid depths).
+    const auto& revisions = p.depth_revisions.at(ns);
+    size_t k = revisions.size() - 1;
+    for (size_t r = 0; r < revisions.size(); ++r) {
+      if (CountFinite(ros1::FloatImageFromMsg(*revisions[r], 1, "depth")) ==
+          static_cast<int>(finite.size()))
+        k = r;
+    }
+    const cv::Mat d = ros1::FloatImageFromMsg(*revisions[k], 1, "depth");
+    const int valid = CountFinite(d);
     EXPECT_EQ(static_cast<int>(finite.size()), valid)
         << "depth image " << StampStr(img->header.stamp);
     EXPECT_GT(valid, 0);
-    // The node's per-view cloud (world frame, every valid pixel in pixel
-    // order) = depth_image_proc's points moved by the DepthView's pose.
-    auto np = p.node_points.find(ns);
+    // The node's per-view cloud of that revision (world frame, every valid
+    // pixel in pixel order) = depth_image_proc's points moved by the
+    // DepthView's pose.
+    auto np = p.node_points_revisions.find(ns);
     auto view = p.views.find(ns);
-    EXPECT_NE(np, p.node_points.end())
+    EXPECT_TRUE(np != p.node_points_revisions.end() && np->second.size() > k)
         << "no /depth_node/points for " << StampStr(img->header.stamp);
-    if (np == p.node_points.end() || view == p.views.end()) continue;
-    EXPECT_EQ(np->second->header.frame_id, "world");
-    const PointCloud world = CloudFromMsg(*np->second);
+    if (np == p.node_points_revisions.end() || np->second.size() <= k ||
+        view == p.views.end())
+      continue;
+    EXPECT_EQ(np->second[k]->header.frame_id, "world");
+    const PointCloud world = CloudFromMsg(*np->second[k]);
     EXPECT_EQ(world.xyz.size(), finite.size());
     if (world.xyz.size() != finite.size() || finite.empty()) continue;
     Camera cam;
