@@ -31,6 +31,13 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry->Add(key("planar_prior"), &o->planar_prior,
                 "fill where growth stopped from the planes of triangles of "
                 "confident samples; false = growth alone (paper)");
+  registry->Add(key("explain_test"), &o->explain_test,
+                "region growing does not expand from a match that R's window "
+                "explains worse than the views explain each other "
+                "(mvs.mpgc.explain_*); false = every match expands (paper)");
+  registry->Add(key("bilateral_window"), &o->bilateral_window,
+                "weight the matching window bilaterally (mvs.mpgc.bilateral_*)"
+                "; false = the plain window (paper)");
 }
 
 }  // namespace wild_mvs

@@ -15,18 +15,18 @@ constexpr double kMinScore = 0.6;  // seed only above this mean NCC
 }  // namespace
 
 void DepthSweepOptions::Check() const {
-  Require(below_seeds >= 0, "mvs.sweep.below_seeds = ", below_seeds,
-          " must be >= 0");
+  Require(below_seeds >= 1, "mvs.sweep.below_seeds = ", below_seeds,
+          " must be >= 1 (1 = only when no sparse feature matched)");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      DepthSweepOptions* o) {
   registry
       ->Add(OptionRegistry::Join(prefix, "below_seeds"), &o->below_seeds,
-            "also seed from a fronto-parallel depth sweep (the pixels still "
-            "empty) when fewer sparse features than this matched; 0 = only "
-            "when none did")
-      .Min(0);
+            "seed the pixels still empty from a fronto-parallel depth sweep "
+            "when fewer sparse features than this matched (1 = only when "
+            "none did)")
+      .Min(1);
 }
 
 std::vector<Seed> SweepSeeds(const PatchContext& context,

@@ -20,10 +20,9 @@ void GeometricConsistencyOptions::Check() const {
           " must be in (0, 1)");
   Require(search_px >= 0 && search_px <= 3,
           "consistency.search_px = ", search_px, " must be in [0, 3]");
-  Require(free_space_margin == -1 ||
-              (free_space_margin >= 0 && free_space_margin < 1),
+  Require(free_space_margin >= 0 && free_space_margin < 1,
           "consistency.free_space_margin = ", free_space_margin,
-          " must be -1 (off) or in [0, 1)");
+          " must be in [0, 1)");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -51,8 +50,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
             "count a neighbour whose depth lies beyond the sample by more "
             "than this relative margin as a violation (it sees through the "
             "sample); a sample needs at least as many confirmations as "
-            "violations; -1 = off")
-      .Min(-1)
+            "violations")
+      .Min(0)
       .Below(1);
 }
 
@@ -80,7 +79,7 @@ enum class Verdict { kNone, kConfirms, kViolates };
 // What neighbour map `nb` says of depth z at pixel (x, y) of ref: it
 // confirms it when the pixel of nb containing the projection q (or, with
 // search_px > 0, any pixel of nb within search_px of it) round-trips; else
-// it violates it when free_space_margin >= 0 and nb's depth at q lies
+// it violates it when nb's depth at q lies
 // beyond X by more than the margin.
 Verdict Judge(const Camera& rc, const DepthMap& nb, int x, int y, double z,
               const GeometricConsistencyOptions& o) {
@@ -95,8 +94,7 @@ Verdict Judge(const Camera& rc, const DepthMap& nb, int x, int y, double z,
     for (int dx = -o.search_px; dx <= o.search_px; ++dx)
       if ((dx != 0 || dy != 0) && RoundTrips(rc, nb, qx + dx, qy + dy, p, z, o))
         return Verdict::kConfirms;
-  if (o.free_space_margin >= 0 && qx >= 0 && qy >= 0 && qx < nb.width() &&
-      qy < nb.height()) {
+  if (qx >= 0 && qy >= 0 && qx < nb.width() && qy < nb.height()) {
     const float zv = nb.depth.at<float>(qy, qx);
     if (zv > 0 && zv > (1 + o.free_space_margin) * nb.camera.Depth(X))
       return Verdict::kViolates;

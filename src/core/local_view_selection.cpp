@@ -14,9 +14,8 @@ void LocalViewSelectionOptions::Check() const {
           "mvs.local.num_active = ", num_active, " must be in [1, 8]");
   Require(min_ncc >= -1 && min_ncc <= 1, "mvs.local.min_ncc = ", min_ncc,
           " must be in [-1, 1]");
-  Require(wide_min_ncc >= -2 && wide_min_ncc <= 1,
-          "mvs.local.wide_min_ncc = ", wide_min_ncc,
-          " must be in [-2, 1] (< -1 = min_ncc)");
+  Require(wide_min_ncc >= -1 && wide_min_ncc <= 1,
+          "mvs.local.wide_min_ncc = ", wide_min_ncc, " must be in [-1, 1]");
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -37,9 +36,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Max(1);
   registry
       ->Add(key("wide_min_ncc"), &o->wide_min_ncc,
-            "min_ncc where the window is wide (window step >= 2); < -1 = "
-            "min_ncc")
-      .Min(-2)
+            "min_ncc where the window is wide (window step >= 2)")
+      .Min(-1)
       .Max(1);
 }
 

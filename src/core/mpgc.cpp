@@ -19,8 +19,8 @@ int AutoWindowStep(int step, int width, int height) {
 void UseWideThresholds(int width, int height, MpgcOptions* mpgc,
                        LocalViewSelectionOptions* local) {
   if (AutoWindowStep(mpgc->window_step, width, height) < 2) return;
-  if (mpgc->wide_drop_ncc >= -1) mpgc->drop_ncc = mpgc->wide_drop_ncc;
-  if (local->wide_min_ncc >= -1) local->min_ncc = local->wide_min_ncc;
+  mpgc->drop_ncc = mpgc->wide_drop_ncc;
+  local->min_ncc = local->wide_min_ncc;
 }
 
 void MpgcOptions::Check() const {
@@ -32,25 +32,26 @@ void MpgcOptions::Check() const {
           " must be in [0, 4] (0 = by image size)");
   Require(drop_ncc >= -1 && drop_ncc <= 1, "mvs.mpgc.drop_ncc = ", drop_ncc,
           " must be in [-1, 1]");
-  Require(wide_drop_ncc >= -2 && wide_drop_ncc <= 1,
-          "mvs.mpgc.wide_drop_ncc = ", wide_drop_ncc,
-          " must be in [-2, 1] (< -1 = drop_ncc)");
-  Require(explain_margin == -1 || (explain_margin >= 0 && explain_margin <= 2),
+  Require(wide_drop_ncc >= -1 && wide_drop_ncc <= 1,
+          "mvs.mpgc.wide_drop_ncc = ", wide_drop_ncc, " must be in [-1, 1]");
+  Require(explain_margin >= 0 && explain_margin <= 2,
           "mvs.mpgc.explain_margin = ", explain_margin,
-          " must be -1 (off) or in [0, 2]");
-  Require(explain_below_ncc >= -1 && explain_below_ncc <= 1.5,
+          " must be in [0, 2] (ablation.explain_test false switches the "
+          "test off)");
+  Require(explain_below_ncc >= -1 && explain_below_ncc <= 1,
           "mvs.mpgc.explain_below_ncc = ", explain_below_ncc,
-          " must be in [-1, 1.5]");
-  Require(std::isfinite(bilateral_sigma_color) && bilateral_sigma_color >= 0,
+          " must be in [-1, 1]");
+  Require(std::isfinite(bilateral_sigma_color) && bilateral_sigma_color > 0,
           "mvs.mpgc.bilateral_sigma_color = ", bilateral_sigma_color,
-          " must be >= 0 (0 = off)");
+          " must be > 0 (ablation.bilateral_window false: the plain "
+          "window)");
   Require(std::isfinite(bilateral_sigma_space) && bilateral_sigma_space > 0,
           "mvs.mpgc.bilateral_sigma_space = ", bilateral_sigma_space,
           " must be > 0");
-  Require(std::isfinite(bilateral_min_weight) && bilateral_min_weight >= 0 &&
+  Require(std::isfinite(bilateral_min_weight) && bilateral_min_weight > 0 &&
               bilateral_min_weight <= 1,
           "mvs.mpgc.bilateral_min_weight = ", bilateral_min_weight,
-          " must be in [0, 1]");
+          " must be in (0, 1]");
   Require(min_active_views >= 1 && min_active_views <= kMaxActive,
           "mvs.mpgc.min_active_views = ", min_active_views, " must be in [1, ",
           kMaxActive, "]");
@@ -299,7 +300,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   }
   // A textureless reference window cannot be matched (NCC undefined).
   if (var_total < kNccMinVariance * npix_ * channels_ * 100) return false;
-  if (mpgc_.bilateral_sigma_color > 0) SetBilateralWeights();
+  if (ctx_.ablation.bilateral_window) SetBilateralWeights();
   for (int c = 0; c < channels_; ++c) {
     double sum = 0;
     for (int i = 0; i < npix_; ++i) sum += weight_[i] * ref_[4 * i + c];
@@ -333,7 +334,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
   return true;
 }
 
-// Bilateral weights of R's window (MpgcOptions::bilateral_sigma_color):
+// Bilateral weights of R's window (MpgcOptions::bilateral_*):
 // closeness to the centre sample in space and in gamma-2 encoded colour.
 void PatchMatcher::SetBilateralWeights() {
   const int centre = npix_ / 2;
@@ -556,7 +557,7 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
   const double mean_ncc = sum / num_active_;
   double pair_ncc = std::numeric_limits<double>::quiet_NaN();
   bool explained = true;
-  if (mpgc_.explain_margin >= 0 && num_active_ >= 2 &&
+  if (ctx_.ablation.explain_test && num_active_ >= 2 &&
       mean_ncc < mpgc_.explain_below_ncc) {
     // Not even the best view explains R's window as well as the views
     // explain each other's. Every NCC is corrected for what the two
@@ -578,7 +579,6 @@ bool PatchMatcher::MakeResult(int iterations, PatchResult* out) const {
           std::max(best, std::min(1.0, slots_[active_slot_[a]].ncc /
                                            std::sqrt(r_ref * reliability[a])));
     explained = best >= pair_ncc - mpgc_.explain_margin;
-    if (!explained && !mpgc_.explain_keeps_match) return false;
   }
   if (!out) return true;
   out->pair_ncc = pair_ncc;
@@ -733,22 +733,14 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Max(kMaxWindow)
       .Odd();
   registry
-      ->Add(key("window_step"), &o->window_step,
-            "pixels between the window's samples (footprint (n - 1) * step "
-            "+ 1; paper: 1); 0 = 2 for working images of 1200 px or more "
-            "on the longer side, else 1")
-      .Min(0)
-      .Max(4);
-  registry
       ->Add(key("drop_ncc"), &o->drop_ncc,
             "drop active views whose NCC falls below (paper: 0.4)")
       .Min(-1)
       .Max(1);
   registry
       ->Add(key("wide_drop_ncc"), &o->wide_drop_ncc,
-            "drop_ncc where the window is wide (window step >= 2); < -1 = "
-            "drop_ncc")
-      .Min(-2)
+            "drop_ncc where the window is wide (window step >= 2)")
+      .Min(-1)
       .Max(1);
   registry
       ->Add(key("min_active_views"), &o->min_active_views,
@@ -758,26 +750,24 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Note("<= local.num_active");
   registry
       ->Add(key("explain_margin"), &o->explain_margin,
-            "fail a match whose best view's NCC with R is more than this "
-            "below the views' mean NCC with each other (R sees something "
-            "they do not: a one-view occluder); -1 = off (paper)")
-      .Min(-1)
+            "explain test (ablation.explain_test): region growing does not "
+            "expand from a match whose best view's NCC with R is more than "
+            "this below the views' mean NCC with each other (R sees "
+            "something they do not: a one-view occluder)")
+      .Min(0)
       .Max(2);
   registry
       ->Add(key("explain_below_ncc"), &o->explain_below_ncc,
-            "explain_margin tests only matches whose mean NCC with R is "
-            "below this (> 1 = every match)")
+            "the explain test checks only matches whose mean NCC with R is "
+            "below this")
       .Min(-1)
-      .Max(1.5);
-  registry->Add(key("explain_keeps_match"), &o->explain_keeps_match,
-                "an unexplained match keeps its depth but region growing "
-                "does not expand from it (false = it fails)");
+      .Max(1);
   registry
       ->Add(key("bilateral_sigma_color"), &o->bilateral_sigma_color,
-            "weight window samples by their colour difference from the "
-            "centre (sigma in 8-bit gamma-2 levels) and distance; 0 = off "
-            "(paper)")
-      .Min(0);
+            "bilateral window (ablation.bilateral_window): weight window "
+            "samples by their colour difference from the centre (sigma in "
+            "8-bit gamma-2 levels) and distance")
+      .Above(0);
   registry
       ->Add(key("bilateral_sigma_space"), &o->bilateral_sigma_space,
             "spatial sigma of the bilateral weights, in window samples")
@@ -785,9 +775,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry
       ->Add(key("bilateral_min_weight"), &o->bilateral_min_weight,
             "least fraction of the plain window weight the colour weights "
-            "keep (sigma_color doubles, up to 8x, until they do); 0 = fixed "
-            "sigma_color")
-      .Min(0)
+            "keep (sigma_color doubles, up to 8x, until they do)")
+      .Above(0)
       .Max(1);
 }
 

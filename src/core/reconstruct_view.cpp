@@ -30,16 +30,12 @@ void MvsOptions::Check() const {
 
 MvsOptions PaperMvsOptions() {
   MvsOptions o;
-  o.mpgc.explain_margin = -1;
-  o.mpgc.explain_below_ncc = 1.1;
-  o.mpgc.explain_keeps_match = false;
-  o.mpgc.bilateral_sigma_color = 0;
-  o.mpgc.wide_drop_ncc = -2;
-  o.local.wide_min_ncc = -2;
+  o.ablation.explain_test = false;
+  o.ablation.bilateral_window = false;
   o.mpgc.window = 5;
   o.mpgc.window_step = 1;
   o.growing.revisit_margin = 0;
-  o.sweep.below_seeds = 0;
+  o.sweep.below_seeds = 1;
   o.ablation.photometric_offset = false;
   o.ablation.consistency = false;
   o.ablation.planar_prior = false;
@@ -204,8 +200,7 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
     if (!seeds.empty())
       GrowRegions(ctx, mpgc, local, options.growing, seeds, wmask, pool,
                   &dm.depth, &dm.normal, &dm.confidence, &stats, cancel);
-    if (stats.seeds_accepted == 0 ||
-        stats.seeds_accepted < options.sweep.below_seeds) {
+    if (stats.seeds_accepted < options.sweep.below_seeds) {
       // No (or too few) sparse features produced a match: seed the pixels
       // still empty from a plane sweep.
       double lo = dmin, hi = dmax;

@@ -175,12 +175,12 @@ TEST(DepthSweep, EmptyRangeOrNoViewsGiveNoSeeds) {
   EXPECT_TRUE(Sweep(alone, cv::Mat(), nullptr).empty());
 }
 
-TEST(DepthSweep, CheckRejectsNegativeBelowSeeds) {
+TEST(DepthSweep, CheckRejectsBelowSeedsUnderOne) {
   DepthSweepOptions o;
   EXPECT_NO_THROW(o.Check());
-  o.below_seeds = 0;
+  o.below_seeds = 1;
   EXPECT_NO_THROW(o.Check());
-  o.below_seeds = -1;
+  o.below_seeds = 0;
   EXPECT_THROW(o.Check(), Error);
 }
 

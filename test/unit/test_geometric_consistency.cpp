@@ -90,10 +90,9 @@ TEST(GeometricConsistency, KeepsTrueDepthsRemovesCorruptedOnes) {
   }
   const int valid = r.CountValid();
   DepthMap r_default = Copy(r);
-  // The exact-pixel filter first (search_px 0, no free-space count).
+  // The exact-pixel filter first (search_px 0).
   GeometricConsistencyOptions o;
   o.search_px = 0;
-  o.free_space_margin = -1;
   const cv::Mat count = CountConsistentViews(r, ptrs, o);
   ConsistencyStats st;
   FilterByConsistency(&r, ptrs, o, &st);
@@ -241,14 +240,20 @@ TEST(GeometricConsistency, FreeSpaceViolationsOutvoteAStrayConfirmation) {
       accomplice.depth.at<float>(qy, qx) = static_cast<float>(t);
     }
   const std::vector<const DepthMap*> ptrs = Pointers(nbs);
-  auto kept = [&](double margin, long* good_kept, long* good, long* bad_kept,
-                  long* bad_all) {
+  // With violations counted (the filter) or by the confirmations alone
+  // (CountConsistentViews >= min_consistent).
+  auto kept = [&](bool violations, long* good_kept, long* good,
+                  long* bad_kept, long* bad_all) {
     DepthMap m = Copy(r);
     GeometricConsistencyOptions o;
     o.search_px = 1;
-    o.free_space_margin = margin;
-    ConsistencyStats st;
-    FilterByConsistency(&m, ptrs, o, &st);
+    if (violations) {
+      ConsistencyStats st;
+      FilterByConsistency(&m, ptrs, o, &st);
+    } else {
+      const cv::Mat count = CountConsistentViews(m, ptrs, o);
+      m.depth.setTo(0, count < o.min_consistent);
+    }
     *good_kept = *good = *bad_kept = *bad_all = 0;
     for (int y = 0; y < m.height(); ++y)
       for (int x = 0; x < m.width(); ++x) {
@@ -264,8 +269,8 @@ TEST(GeometricConsistency, FreeSpaceViolationsOutvoteAStrayConfirmation) {
       }
   };
   long gk0, g0, bk0, b0, gk1, g1, bk1, b1;
-  kept(-1, &gk0, &g0, &bk0, &b0);
-  kept(0.01, &gk1, &g1, &bk1, &b1);
+  kept(false, &gk0, &g0, &bk0, &b0);
+  kept(true, &gk1, &g1, &bk1, &b1);
   std::printf(
       "confirmations only: true kept %ld / %ld, floating kept %ld / %ld\n"
       "with free-space violations: true kept %ld / %ld, floating kept %ld / "
@@ -279,7 +284,9 @@ TEST(GeometricConsistency, FreeSpaceViolationsOutvoteAStrayConfirmation) {
   GeometricConsistencyOptions o;
   o.free_space_margin = 1.5;
   EXPECT_THROW(o.Check(), std::exception);
-  o.free_space_margin = -1;
+  o.free_space_margin = -0.01;
+  EXPECT_THROW(o.Check(), std::exception);
+  o.free_space_margin = 0;
   EXPECT_NO_THROW(o.Check());
 }
 

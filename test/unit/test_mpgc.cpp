@@ -49,7 +49,7 @@ MpgcGridStats RunMpgcGrid(const SyntheticScene& s, int ref, int n,
   mo.window = n;
   mo.window_step = step;
   // The plain window unless asked (the bilateral one is tested below).
-  mo.bilateral_sigma_color = sigma_color;
+  if (sigma_color > 0) mo.bilateral_sigma_color = sigma_color;
   // The paper's photometric model (a scale only) by default: then the
   // fitted scales must equal the exposure ratios. With the offset the scale
   // is a contrast ratio (the gain splits between c and b), so only depth
@@ -57,6 +57,7 @@ MpgcGridStats RunMpgcGrid(const SyntheticScene& s, int ref, int n,
   PatchContext ctx = MakeContext(s, ref);
   ctx.window = n;
   ctx.ablation.photometric_offset = offset;
+  ctx.ablation.bilateral_window = sigma_color > 0;
   PatchMatcher matcher(ctx, mo, LocalViewSelectionOptions());
   const auto& lr = s.spec.lighting[ref];
   MpgcGridStats st;
@@ -167,8 +168,8 @@ TEST(MvsMpgc, RecoversSlantedPlaneDepthNormalAndColourScales) {
   EXPECT_EQ(AutoWindowStep(0, 1024, 1536), 2);
   EXPECT_EQ(AutoWindowStep(3, 640, 480), 3);
   EXPECT_EQ(AutoWindowStep(1, 3072, 2048), 1);
-  // Wide windows take the wide thresholds; an explicit step 1 or < -1
-  // keeps the plain ones.
+  // Wide windows take the wide thresholds; an explicit step 1 keeps the
+  // plain ones.
   {
     MpgcOptions m;
     LocalViewSelectionOptions l;
@@ -184,13 +185,12 @@ TEST(MvsMpgc, RecoversSlantedPlaneDepthNormalAndColourScales) {
     LocalViewSelectionOptions l1;
     UseWideThresholds(1536, 1024, &one, &l1);
     EXPECT_EQ(one.drop_ncc, MpgcOptions().drop_ncc);
-    MpgcOptions off;
-    off.wide_drop_ncc = -2;
-    LocalViewSelectionOptions loff;
-    loff.wide_min_ncc = -2;
-    UseWideThresholds(1536, 1024, &off, &loff);
-    EXPECT_EQ(off.drop_ncc, MpgcOptions().drop_ncc);
-    EXPECT_EQ(loff.min_ncc, LocalViewSelectionOptions().min_ncc);
+    MpgcOptions below;
+    below.wide_drop_ncc = -1.5;
+    EXPECT_THROW(below.Check(), std::exception);
+    LocalViewSelectionOptions lbelow;
+    lbelow.wide_min_ncc = -1.5;
+    EXPECT_THROW(lbelow.Check(), std::exception);
   }
 
   // Without normal optimisation the normal stays fronto-parallel.
@@ -209,25 +209,30 @@ TEST(MvsMpgc, RecoversSlantedPlaneDepthNormalAndColourScales) {
 // Near the edge the plain window of a wall pixel is partly board, so MPGC
 // started at the board's depth (what growth from the board proposes) keeps
 // it there: the board's outline grows into the wall ("edge fattening").
-// The bilateral window (mpgc.bilateral_sigma_color) weighs the board's
+// The bilateral window (ablation.bilateral_window) weighs the board's
 // samples down in a wall pixel's window and the other way round.
 struct EdgeStats {
   int tested = 0, right = 0, wrong = 0;
 };
 
+// A least weight this small never widens the colour sigma: a fixed sigma.
+constexpr double kFixedSigma = 1e-9;
+
+// sigma_color 0: the plain window (ablation.bilateral_window false).
 EdgeStats RunDepthEdge(const SyntheticScene& s, double sigma_color,
                        double sigma_space, double kappa,
-                       double min_weight = 0) {
+                       double min_weight = kFixedSigma) {
   const int ref = 2;
   MpgcOptions mo;
-  mo.bilateral_sigma_color = sigma_color;
+  if (sigma_color > 0) mo.bilateral_sigma_color = sigma_color;
   mo.bilateral_sigma_space = sigma_space;
   mo.bilateral_min_weight = min_weight;
   mo.drop_ncc = kappa;
   mo.Check();
   LocalViewSelectionOptions lo;
   lo.min_ncc = kappa - 0.1;
-  const PatchContext ctx = MakeContext(s, ref);
+  PatchContext ctx = MakeContext(s, ref);
+  ctx.ablation.bilateral_window = sigma_color > 0;
   PatchMatcher matcher(ctx, mo, lo);
   const cv::Mat& id = s.object_id[ref];
   const cv::Mat& depth = s.depth[ref];
@@ -310,9 +315,10 @@ TEST(MvsMpgc, BilateralWindowKeepsDepthEdgesSharp) {
       defaults.wide_drop_ncc, defaults.bilateral_min_weight);
   EXPECT_LT(now.wrong, plain_low.wrong - plain_low.wrong / 10);
   EXPECT_GT(now.right, plain_low.right);
-  // Options: a colour sigma < 0 or a spatial sigma <= 0 is refused.
+  // Options: a colour or spatial sigma <= 0 is refused (the plain window
+  // is ablation.bilateral_window false).
   MpgcOptions bad;
-  bad.bilateral_sigma_color = -1;
+  bad.bilateral_sigma_color = 0;
   EXPECT_THROW(bad.Check(), std::exception);
   bad.bilateral_sigma_color = 30;
   bad.bilateral_sigma_space = 0;
@@ -322,11 +328,13 @@ TEST(MvsMpgc, BilateralWindowKeepsDepthEdgesSharp) {
 // Interior pixels of a slanted, finely textured plane (every window's
 // colour varies across it, none straddles an edge), started 2 % off the
 // true depth: how many MPGC brings within 1 % (right) or elsewhere (wrong).
-EdgeStats RunFineTexture(const SyntheticScene& s, const MpgcOptions& mo) {
+EdgeStats RunFineTexture(const SyntheticScene& s, const MpgcOptions& mo,
+                         bool bilateral) {
   const int ref = 2;
   LocalViewSelectionOptions lo;
   lo.min_ncc = mo.drop_ncc - 0.1;
-  const PatchContext ctx = MakeContext(s, ref);
+  PatchContext ctx = MakeContext(s, ref);
+  ctx.ablation.bilateral_window = bilateral;
   PatchMatcher matcher(ctx, mo, lo);
   const cv::Mat& depth = s.depth[ref];
   EdgeStats st;
@@ -341,25 +349,23 @@ EdgeStats RunFineTexture(const SyntheticScene& s, const MpgcOptions& mo) {
       (std::abs(res.depth - gt) <= 0.01 * gt ? st.right : st.wrong)++;
     }
   std::printf(
-      "fine texture, bilateral sigma %.0f min weight %.2f: %d tested, %d "
-      "right, %d wrong\n",
-      mo.bilateral_sigma_color, mo.bilateral_min_weight, st.tested, st.right,
-      st.wrong);
+      "fine texture, bilateral %d sigma %.0f min weight %.2f: %d tested, "
+      "%d right, %d wrong\n",
+      bilateral, mo.bilateral_sigma_color, mo.bilateral_min_weight, st.tested,
+      st.right, st.wrong);
   return st;
 }
 
 TEST(MvsMpgc, BilateralMinWeightKeepsFineTexture) {
   const SyntheticScene s =
       Render(WallSpec(Eigen::Vector3d(0, 0.8, 0.6), 5, 0.012, 160));
-  MpgcOptions plain;
-  plain.bilateral_sigma_color = 0;
   MpgcOptions fixed;
-  fixed.bilateral_min_weight = 0;
+  fixed.bilateral_min_weight = kFixedSigma;
   MpgcOptions adaptive;
   adaptive.bilateral_min_weight = 0.5;
-  const EdgeStats p = RunFineTexture(s, plain);
-  const EdgeStats f = RunFineTexture(s, fixed);
-  const EdgeStats a = RunFineTexture(s, adaptive);
+  const EdgeStats p = RunFineTexture(s, MpgcOptions(), false);
+  const EdgeStats f = RunFineTexture(s, fixed, true);
+  const EdgeStats a = RunFineTexture(s, adaptive, true);
   // The fixed colour sigma loses right matches here (measured: plain 1409
   // right / 115 wrong, sigma 12 1227 / 126); keeping half the window's
   // weight wins back at least a third of them (measured: 1307 / 115)
@@ -368,11 +374,11 @@ TEST(MvsMpgc, BilateralMinWeightKeepsFineTexture) {
   EXPECT_LT(f.right, p.right - p.right / 20);
   EXPECT_GT(a.right, f.right + (p.right - f.right) / 3);
   EXPECT_LE(a.wrong, f.wrong);
-  // Options: the fraction lies in [0, 1].
+  // Options: the fraction lies in (0, 1].
   MpgcOptions bad;
   bad.bilateral_min_weight = 1.5;
   EXPECT_THROW(bad.Check(), std::exception);
-  bad.bilateral_min_weight = -0.1;
+  bad.bilateral_min_weight = 0;
   EXPECT_THROW(bad.Check(), std::exception);
 }
 

@@ -66,7 +66,7 @@ struct KernelCase {
   mk::SampleArgs args;
 
   // weighted: the lanes of `mask` hold random root weights in [0.2, 1] per
-  // pixel (the bilateral window, MpgcOptions::bilateral_sigma_color), and
+  // pixel (the bilateral window, MpgcOptions::bilateral_*), and
   // ref_c is R's weighted deviation from its weighted mean, times w.
   KernelCase(std::mt19937* rng, int window, int ch, bool weighted = false)
       : channels(ch) {

@@ -21,6 +21,11 @@ struct AblationOptions {
   bool photometric_offset = true;    // I_R = c I_V + b; false = c I_V (paper)
   bool consistency = true;   // filter of the finished maps (beyond paper)
   bool planar_prior = true;  // fill from triangle planes (beyond paper)
+  // The explain test (MpgcOptions::explain_margin; beyond the paper).
+  bool explain_test = true;
+  // Bilateral window weights (MpgcOptions::bilateral_*; beyond the paper);
+  // false = the plain window.
+  bool bilateral_window = true;
 };
 
 // Registers the switches under `prefix` (e.g. "ablation").

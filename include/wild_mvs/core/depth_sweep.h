@@ -14,8 +14,8 @@
 namespace wild_mvs {
 
 struct DepthSweepOptions {
-  // The sweep seeds the pixels still empty also when fewer than this many
-  // sparse features matched, >= 0; 0 = only when none matched.
+  // The sweep seeds the pixels still empty when fewer than this many sparse
+  // features matched, >= 1 (1 = only when none matched).
   int below_seeds = 20;
   void Check() const;
 };

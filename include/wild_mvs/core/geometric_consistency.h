@@ -15,8 +15,8 @@
 // visibility-based fusion of depth maps", ICCV 2007): V's depth at the pixel
 // containing q lies beyond X by more than free_space_margin (z_V > (1 +
 // margin) d_V(X)), so V sees through the sample: either the sample or V's
-// depth is wrong. With free_space_margin >= 0 a sample also needs at least
-// as many confirmations as violations. Wrong depths floating in front of
+// depth is wrong. A sample also needs at least as many confirmations as
+// violations. Wrong depths floating in front of
 // the surface (sky, background seen through gaps) are contradicted by the
 // many views that see past them; a right depth is at most contradicted by
 // the few views whose own estimate there is wrong.
@@ -35,7 +35,7 @@ struct GeometricConsistencyOptions {
   double max_reprojection_px = 1.0;  // forward-backward distance in R, px
   double max_relative_depth = 0.01;  // |z' - z| / z, (0, 1)
   // Free-space violations counted beyond this relative depth, [0, 1); a
-  // sample needs confirmations >= violations. -1 = not counted.
+  // sample needs confirmations >= violations.
   double free_space_margin = 0.01;
   // Pixels of V tried around the one containing q, [0, 3] (not registered;
   // tests vary it): 0 = that pixel only; 1 = its 3x3 neighbourhood (any of
@@ -56,16 +56,15 @@ struct ConsistencyStats {
 
 // Per pixel of ref, the number of `neighbors` (maps of other views, any
 // resolution) that confirm its depth (CV_8U; 0 where ref has no depth).
-// violations (may be null): the number that see through it (CV_8U; counted
-// only when options.free_space_margin >= 0, else all 0).
+// violations (may be null): the number that see through it (CV_8U).
 cv::Mat CountConsistentViews(const DepthMap& ref,
                              const std::vector<const DepthMap*>& neighbors,
                              const GeometricConsistencyOptions& options,
                              cv::Mat* violations = nullptr);
 
 // Removes the samples of *ref (depth, normal and confidence set to 0) that
-// fewer than options.min_consistent of `neighbors` confirm, or (with
-// free_space_margin >= 0) that more neighbours see through than confirm.
+// fewer than options.min_consistent of `neighbors` confirm, or that more
+// neighbours see through than confirm.
 // No-op when no neighbour map is given (nothing to check against:
 // stats->kept = samples).
 void FilterByConsistency(DepthMap* ref,

@@ -16,8 +16,7 @@ constexpr double kMaxEpipolarAngleDeg = 10;
 struct LocalViewSelectionOptions {
   int num_active = 4;    // m = |A|, [1, 8] (paper: 4)
   double min_ncc = 0.3;  // NCC to enter A, [-1, 1] (paper: 0.3)
-  // min_ncc where the window is wide (MpgcOptions::wide_drop_ncc), [-2, 1];
-  // < -1 = min_ncc.
+  // min_ncc where the window is wide (MpgcOptions::wide_drop_ncc), [-1, 1].
   double wide_min_ncc = 0.12;
   void Check() const;
 };

@@ -43,30 +43,29 @@ constexpr double kMinFacing = 0.1;
 struct MpgcOptions {
   int window = 5;  // n of the n x n window, odd, [3, kMaxWindow] (paper: 5)
   // Pixels between the window's samples, [0, 4] (paper: 1); 0 = by R's
-  // working size (AutoWindowStep).
+  // working size (AutoWindowStep). Not registered: the working size decides
+  // (docs/METHODS.md, "Tried and rejected"); tests and --preset paper set it.
   int window_step = 0;
   double drop_ncc = 0.4;  // kappa: drop active views below, [-1, 1]
-  // kappa where the window is wide (step >= 2), [-2, 1]; < -1 = drop_ncc.
+  // kappa where the window is wide (step >= 2), [-1, 1].
   double wide_drop_ncc = 0.22;
   int min_active_views = 3;  // fail with fewer active views, [1, kMaxActive]
-  // A converged match is unexplained when the best NCC of an active view
-  // with R is more than this below the active views' mean NCC with each
-  // other, both corrected for the windows' noise (image_noise.h), [0, 2];
-  // -1 = off (paper).
+  // The explain test (AblationOptions::explain_test): a converged match is
+  // unexplained when the best NCC of an active view with R is more than
+  // this below the active views' mean NCC with each other, both corrected
+  // for the windows' noise (image_noise.h), [0, 2]. An unexplained match
+  // keeps its depth but is not expanded from (PatchResult::explained).
   double explain_margin = 0;
-  // Only matches whose mean NCC with R is below this are tested, [-1, 1.5].
+  // Only matches whose mean NCC with R is below this are tested, [-1, 1].
   double explain_below_ncc = 0.8;
-  // An unexplained match keeps its depth but is not expanded from
-  // (PatchResult::explained); false = it fails.
-  bool explain_keeps_match = true;
-  // Bilateral window weights: exp(-d^2 / 2 sigma_space^2), d in window
-  // samples, times exp(-dc^2 / 2 sigma_color^2), dc the RMS colour
-  // difference from the centre in 8-bit gamma-2 levels; sigma_color 0 = off
-  // (paper), >= 0; sigma_space > 0.
+  // Bilateral window weights (AblationOptions::bilateral_window):
+  // exp(-d^2 / 2 sigma_space^2), d in window samples, times
+  // exp(-dc^2 / 2 sigma_color^2), dc the RMS colour difference from the
+  // centre in 8-bit gamma-2 levels; sigma_color > 0, sigma_space > 0.
   double bilateral_sigma_color = 12;
   double bilateral_sigma_space = 6;
-  // Least fraction, [0, 1], of the space-only weight the colour weights
-  // keep (sigma_color doubles, up to 8x, until they do); 0 = fixed sigma.
+  // Least fraction, (0, 1], of the space-only weight the colour weights
+  // keep (sigma_color doubles, up to 8x, until they do).
   double bilateral_min_weight = 0.5;
   void Check() const;
 };
@@ -76,7 +75,7 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
 
 // The thresholds for a reference image of width x height: where its window
 // is wide (AutoWindowStep >= 2) drop_ncc and local.min_ncc become
-// wide_drop_ncc and local.wide_min_ncc (unless those are < -1).
+// wide_drop_ncc and local.wide_min_ncc.
 void UseWideThresholds(int width, int height, MpgcOptions* mpgc,
                        LocalViewSelectionOptions* local);
 
@@ -113,8 +112,8 @@ struct PatchResult {
   // Mean NCC of A's views with each other, corrected for noise (computed
   // when the explain test ran, else NaN).
   double pair_ncc = std::numeric_limits<double>::quiet_NaN();
-  // False when the explain test failed and explain_keeps_match kept the
-  // match: growth does not expand from it.
+  // False when the explain test failed: the match keeps its depth, growth
+  // does not expand from it.
   bool explained = true;
   int iterations = 0;
   int num_active = 0;
