@@ -85,6 +85,28 @@ double EstimateSceneDepth(const Scene& scene, int ref,
     }
   }
   if (depths.empty()) {
+    // The nearest views' own point depths (R's camera sees none of the
+    // points: no feature of its own, and none of the others' in its view).
+    std::vector<std::pair<double, int>> near;
+    for (size_t v = 0; v < scene.views.size(); ++v) {
+      if (static_cast<int>(v) == ref || v >= points_per_view.size() ||
+          points_per_view[v].empty())
+        continue;
+      near.emplace_back(
+          (scene.views[v].camera.Center() - cr.Center()).squaredNorm(),
+          static_cast<int>(v));
+    }
+    std::sort(near.begin(), near.end());
+    for (size_t k = 0;
+         k < near.size() && static_cast<int>(k) < kNearestViewsForDepth; ++k) {
+      const Camera& cv = scene.views[near[k].second].camera;
+      for (int p : points_per_view[near[k].second]) {
+        const double z = cv.Depth(scene.points[p].xyz);
+        if (z > 0 && std::isfinite(z)) depths.push_back(z);
+      }
+    }
+  }
+  if (depths.empty()) {
     // Closest approach of the optical axes of R and each other view.
     for (size_t v = 0; v < scene.views.size(); ++v) {
       if (static_cast<int>(v) == ref) continue;

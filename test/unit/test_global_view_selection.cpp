@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
+#include <string>
 #include <vector>
 
 #include "mvs_test_scenes.h"
@@ -240,6 +242,58 @@ TEST(MvsGlobalViewSelection, PrefersParallaxAndMatchingResolution) {
   for (size_t i = 2; i < sel.neighbors.size(); ++i)
     EXPECT_LT(sel.scores[i], 0.5 * sel.scores[1]);
   EXPECT_GT(sel.scores[0], 0);
+}
+
+}  // namespace
+}  // namespace wild_mvs
+
+namespace wild_mvs {
+namespace {
+
+// A camera moving along a wall 3 away, looking at it: the first view sees
+// none of the sparse points (its part of the wall gave no feature), so
+// neither its own points nor the others' in its frustum give its scene
+// depth. The depths its nearest views see of their own points do (the
+// optical axes are parallel and never cross).
+TEST(MvsGlobalViewSelection, SceneDepthOfAViewWithoutPointsFromItsNearestViews) {
+  Scene scene;
+  for (int i = 0; i < 9; ++i) {
+    View v;
+    v.name = "view_" + std::to_string(i);
+    const Eigen::Vector3d c(0.25 * i, 0, 0);
+    v.camera = testing::LookAtCamera(c, c + Eigen::Vector3d(0, 3, 0), 400,
+                                     320, 240);
+    scene.views.push_back(v);
+  }
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> ux(1.5, 4.0), uz(-0.8, 0.8);
+  for (int i = 0; i < 300; ++i) {
+    SparsePoint p;
+    p.xyz = Eigen::Vector3d(ux(rng), 3.0, uz(rng));
+    for (int v = 0; v < 9; ++v) {
+      Eigen::Vector2d px;
+      if (!scene.views[v].camera.Project(p.xyz, &px) ||
+          !scene.views[v].camera.InImage(px))
+        continue;
+      Observation ob;
+      ob.view = v;
+      ob.xy = px;
+      p.track.push_back(ob);
+    }
+    if (p.track.size() >= 2) scene.points.push_back(p);
+  }
+  const auto ppv = scene.PointsPerView();
+  ASSERT_TRUE(ppv[0].empty());
+  for (const SparsePoint& p : scene.points) {
+    Eigen::Vector2d px;
+    ASSERT_FALSE(scene.views[0].camera.Project(p.xyz, &px) &&
+                 scene.views[0].camera.InImage(px));
+  }
+  double lo = 0, hi = 0;
+  const double z = EstimateSceneDepth(scene, 0, ppv, &lo, &hi);
+  EXPECT_NEAR(z, 3.0, 0.03);
+  EXPECT_GT(lo, 0);
+  EXPECT_GE(hi, lo);
 }
 
 }  // namespace

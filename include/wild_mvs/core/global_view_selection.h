@@ -53,8 +53,14 @@ GlobalViewSelection SelectViewsByFrustumOverlap(
     const Scene& scene, int ref, double scene_depth,
     const GlobalViewSelectionOptions& options);
 
+// Views whose own points give the scene depth of a view that sees none.
+constexpr int kNearestViewsForDepth = 3;
+
 // A typical scene depth (z in R) for R: the median depth of the sparse points
-// R sees; else of all sparse points inside R's frustum; else where the
+// R sees; else of all sparse points inside R's frustum; else the depths of
+// the points seen by the kNearestViewsForDepth views whose centres are
+// nearest R's, each in its own view (a view whose texture gave no feature
+// looks at a scene as far away as its nearest views do); else where the
 // optical axes of R and the other views pass closest. Returns 0 when none
 // of these exists.
 double EstimateSceneDepth(const Scene& scene, int ref,
