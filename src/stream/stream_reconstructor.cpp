@@ -348,14 +348,16 @@ StreamReconstructor::Snapshot StreamReconstructor::MakeSnapshotLocked() const {
 }
 
 StreamReconstructor::Neighborhood StreamReconstructor::Evaluate(
-    const Snapshot& snap, int index) const {
+    const Snapshot& snap, int index, bool idle) const {
   Neighborhood nb;
   if (snap.scene.views.size() < 2) return nb;
   GlobalViewSelection sel = SelectGlobalViews(
       snap.scene, index, snap.points_per_view, options_.mvs.global);
-  // Frustum-overlap fallbacks count only when there are no sparse points at
-  // all (otherwise the keyframe should wait for shared features).
-  if (!sel.fallbacks.empty() && !snap.scene.points.empty()) return nb;
+  // Frustum-overlap fallbacks count when there are no sparse points at all
+  // or the stream is idle; otherwise the keyframe waits for shared
+  // features (a later keyframe may bring them).
+  if (!sel.fallbacks.empty() && !snap.scene.points.empty() && !idle)
+    return nb;
   for (double s : sel.scores) {
     if (s > 0) {
       ++nb.good;
@@ -390,7 +392,7 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
     const KeyframePtr& kf = snap.keyframes[i];
     if (!kf->owned || in_flight_.count(kf->id)) continue;
     if (kf->reconstructions > 0) continue;
-    const Neighborhood nb = Evaluate(snap, static_cast<int>(i));
+    const Neighborhood nb = Evaluate(snap, static_cast<int>(i), idle);
     // MPGC needs min_active_views neighbours to match at all.
     if (nb.good <
         std::max(options_.min_neighbors, options_.mvs.mpgc.min_active_views))
@@ -723,7 +725,7 @@ int StreamReconstructor::GoodNeighbors(uint32_t id) const {
   const Snapshot snap = MakeSnapshotLocked();
   for (size_t i = 0; i < snap.keyframes.size(); ++i)
     if (snap.keyframes[i]->id == id)
-      return Evaluate(snap, static_cast<int>(i)).good;
+      return Evaluate(snap, static_cast<int>(i), false).good;
   return 0;
 }
 

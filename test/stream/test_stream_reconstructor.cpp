@@ -75,8 +75,9 @@ struct Collector {
 };
 
 // Feeds every frame and flushes.
-void Play(StreamReconstructor& stream, const SyntheticScene& s) {
-  stream.SetSparsePoints(StampedPoints(s));
+void Play(StreamReconstructor& stream, const SyntheticScene& s,
+          const std::vector<StreamReconstructor::StampedPoint>& points) {
+  stream.SetSparsePoints(points);
   for (size_t i = 0; i < s.scene.views.size(); ++i)
     stream.AddFrame(double(i), "camera", s.scene.views[i].camera, s.images[i]);
   for (int k = 0; k < 50; ++k) {
@@ -87,6 +88,9 @@ void Play(StreamReconstructor& stream, const SyntheticScene& s) {
     if (st.pending == 0 && k > 8) break;
   }
   stream.WaitIdle();
+}
+void Play(StreamReconstructor& stream, const SyntheticScene& s) {
+  Play(stream, s, StampedPoints(s));
 }
 
 TEST(StreamReconstructor, DepthMapsMatchGroundTruth) {
@@ -118,6 +122,45 @@ TEST(StreamReconstructor, DepthMapsMatchGroundTruth) {
     EXPECT_GT(m.relative_accuracy[1], 0.8) << "keyframe " << v;  // 2 %
   }
   EXPECT_EQ(ids.size(), 6u);
+}
+
+// A keyframe that shares no sparse feature with any other (the tracker
+// found nothing on its texture) waits for shared features while keyframes
+// arrive; once the stream is idle it is matched with the neighbours that
+// frustum overlap gives, as the offline tool matches such a view at once.
+// Every keyframe gets a depth map, and this one is as accurate.
+TEST(StreamReconstructor, KeyframeWithoutSharedFeaturesIsMatchedWhenIdle) {
+  const SyntheticScene& s = Scene6();
+  std::vector<StreamReconstructor::StampedPoint> points = StampedPoints(s);
+  for (StreamReconstructor::StampedPoint& p : points) {
+    auto& obs = p.observations;
+    obs.erase(std::remove_if(obs.begin(), obs.end(),
+                             [](const auto& o) { return o.stamp == 0.0; }),
+              obs.end());
+  }
+  Collector c;
+  StreamReconstructor stream(FastOptions(), c.OnResult(), c.OnError());
+  Play(stream, s, points);
+  EXPECT_TRUE(c.errors.empty()) << c.errors.front();
+  std::set<uint32_t> ids;
+  bool first = false;
+  for (const StreamResult& r : c.results) {
+    if (r.revision != 0) continue;
+    ids.insert(r.keyframe_id);
+    if (r.keyframe_id != 0) continue;
+    first = true;
+    const DepthMetrics m = EvaluateDepth(r.depth.depth, r.depth.camera,
+                                         s.depth[0], s.scene.views[0].camera);
+    std::printf("keyframe 0 without shared features: %s\n",
+                m.ToString().c_str());
+    EXPECT_GT(m.completeness, 0.5) << m.ToString();
+    EXPECT_LT(m.median_rel_error, 0.01);
+  }
+  EXPECT_TRUE(first) << "keyframe 0 got no depth map";
+  EXPECT_EQ(ids.size(), 6u);
+  // ... and its final revision, as every other keyframe.
+  EXPECT_EQ(stream.Stats().revised, 6u);
+  EXPECT_EQ(stream.Stats().unrevised, 0);
 }
 
 // The live path runs the offline pipeline's steps: a keyframe is delivered

@@ -275,7 +275,11 @@ class StreamReconstructor {
     std::vector<std::vector<int>> points_per_view;
   };
   Snapshot MakeSnapshotLocked() const;
-  Neighborhood Evaluate(const Snapshot& snap, int index) const;
+  // The keyframe's neighbours as global view selection finds them. Its
+  // frustum-overlap fallback (no shared sparse feature) counts only when
+  // the scene has no sparse points or `idle` (no later keyframe to wait
+  // for: the offline tool takes it at once).
+  Neighborhood Evaluate(const Snapshot& snap, int index, bool idle) const;
   void ScheduleLocked();  // matching, then revisions
   void ScheduleMatchingLocked(bool idle);
   void RunReconstruction(uint32_t id, uint64_t generation);
