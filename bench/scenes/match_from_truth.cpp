@@ -39,8 +39,8 @@ struct Tally {
 // Other views whose ground truth sees the surface point of (x, y) in ref.
 int SeenBy(const testing::SyntheticScene& s, int ref, int x, int y) {
   const Camera& rc = s.scene.views[ref].camera;
-  const Eigen::Vector3d X = rc.Backproject(
-      Eigen::Vector2d(x + 0.5, y + 0.5), s.depth[ref].at<float>(y, x));
+  const Eigen::Vector3d X = rc.Backproject(Eigen::Vector2d(x + 0.5, y + 0.5),
+                                           s.depth[ref].at<float>(y, x));
   int seen = 0;
   for (size_t v = 0; v < s.scene.views.size(); ++v) {
     if (static_cast<int>(v) == ref) continue;
@@ -88,27 +88,33 @@ Tally MatchView(const testing::SyntheticScene& s, int ref,
 }
 
 int Run(int argc, char** argv) {
-  Require(argc >= 2, "usage: match_from_truth relief|weak [--seed S] "
-                     "[--window N] [--step K] [--width W]");
+  Require(argc >= 2,
+          "usage: match_from_truth relief|weak [--seed S] "
+          "[--window N] [--step K] [--width W]");
   const std::string kind = argv[1];
-  Require(kind == "relief" || kind == "weak", "match_from_truth: unknown "
-          "family '", kind, "' (relief or weak)");
+  Require(kind == "relief" || kind == "weak",
+          "match_from_truth: unknown family '", kind, "' (relief or weak)");
   families::FamilyOptions fo;
   MpgcOptions mo;
   mo.window_step = 1;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     const int v = std::atoi(argv[i + 1]);
-    if (a == "--seed") fo.seed = static_cast<unsigned>(v);
-    else if (a == "--window") mo.window = v;
-    else if (a == "--step") mo.window_step = v;
-    else if (a == "--width") fo.width = v, fo.height = v * 3 / 4;
-    else Require(false, "match_from_truth: unknown argument '", a, "'");
+    if (a == "--seed")
+      fo.seed = static_cast<unsigned>(v);
+    else if (a == "--window")
+      mo.window = v;
+    else if (a == "--step")
+      mo.window_step = v;
+    else if (a == "--width")
+      fo.width = v, fo.height = v * 3 / 4;
+    else
+      Require(false, "match_from_truth: unknown argument '", a, "'");
   }
   mo.Check();
-  const testing::SyntheticScene s = testing::Render(
-      kind == "relief" ? families::ReliefScene(fo)
-                       : families::WeakTextureScene(fo));
+  const testing::SyntheticScene s =
+      testing::Render(kind == "relief" ? families::ReliefScene(fo)
+                                       : families::WeakTextureScene(fo));
   Tally all;
   for (size_t v = 0; v < s.scene.views.size(); ++v) {
     const Tally t = MatchView(s, static_cast<int>(v), mo);

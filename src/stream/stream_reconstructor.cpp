@@ -356,8 +356,7 @@ StreamReconstructor::Neighborhood StreamReconstructor::Evaluate(
   // Frustum-overlap fallbacks count when there are no sparse points at all
   // or the stream is idle; otherwise the keyframe waits for shared
   // features (a later keyframe may bring them).
-  if (!sel.fallbacks.empty() && !snap.scene.points.empty() && !idle)
-    return nb;
+  if (!sel.fallbacks.empty() && !snap.scene.points.empty() && !idle) return nb;
   for (double s : sel.scores) {
     if (s > 0) {
       ++nb.good;

@@ -147,8 +147,9 @@ Growth Grow(const SyntheticScene& s, bool explain_test) {
             normal = cv::Mat::zeros(H, W, CV_32FC3),
             conf = cv::Mat::zeros(H, W, CV_32F);
     GrowStats st;
-    GrowRegions(ctx, MpgcOptions(), LocalViewSelectionOptions(), RegionGrowingOptions(),
-                seeds, cv::Mat(), nullptr, &depth, &normal, &conf, &st);
+    GrowRegions(ctx, MpgcOptions(), LocalViewSelectionOptions(),
+                RegionGrowingOptions(), seeds, cv::Mat(), nullptr, &depth,
+                &normal, &conf, &st);
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         const float z = s.depth[ref].at<float>(y, x);

@@ -242,8 +242,8 @@ TEST(GeometricConsistency, FreeSpaceViolationsOutvoteAStrayConfirmation) {
   const std::vector<const DepthMap*> ptrs = Pointers(nbs);
   // With violations counted (the filter) or by the confirmations alone
   // (CountConsistentViews >= min_consistent).
-  auto kept = [&](bool violations, long* good_kept, long* good,
-                  long* bad_kept, long* bad_all) {
+  auto kept = [&](bool violations, long* good_kept, long* good, long* bad_kept,
+                  long* bad_all) {
     DepthMap m = Copy(r);
     GeometricConsistencyOptions o;
     o.search_px = 1;

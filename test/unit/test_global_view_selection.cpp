@@ -255,14 +255,15 @@ namespace {
 // neither its own points nor the others' in its frustum give its scene
 // depth. The depths its nearest views see of their own points do (the
 // optical axes are parallel and never cross).
-TEST(MvsGlobalViewSelection, SceneDepthOfAViewWithoutPointsFromItsNearestViews) {
+TEST(MvsGlobalViewSelection,
+     SceneDepthOfAViewWithoutPointsFromItsNearestViews) {
   Scene scene;
   for (int i = 0; i < 9; ++i) {
     View v;
     v.name = "view_" + std::to_string(i);
     const Eigen::Vector3d c(0.25 * i, 0, 0);
-    v.camera = testing::LookAtCamera(c, c + Eigen::Vector3d(0, 3, 0), 400,
-                                     320, 240);
+    v.camera =
+        testing::LookAtCamera(c, c + Eigen::Vector3d(0, 3, 0), 400, 320, 240);
     scene.views.push_back(v);
   }
   std::mt19937 rng(5);

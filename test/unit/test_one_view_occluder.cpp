@@ -143,8 +143,8 @@ MpgcOptions ExplainOn() {
 TEST(OneViewOccluder, MpgcAtTheBackgroundBehindTheBox) {
   const Scenes& s = Get();
   MpgcOptions off;
-  off.explain_margin = 2;       // computes pair_ncc but explains every match
-  off.explain_below_ncc = 1;    // for every match
+  off.explain_margin = 2;     // computes pair_ncc but explains every match
+  off.explain_below_ncc = 1;  // for every match
   const Tally box_off = MatchPixels(s, off, true);
   const Tally scene_off = MatchPixels(s, off, false);
   const Tally box_on = MatchPixels(s, ExplainOn(), true);
