@@ -95,93 +95,117 @@ geometry_msgs::Pose PoseMsg(const Eigen::Isometry3d& T) {
   return p;
 }
 
-TEST(PoseSources, OdometryTransformAndPoseWithCovarianceAreInterpolated) {
-  ros::NodeHandle nh;
-  const SyntheticScene scene = Render(RosTestSpec(kViews));
-  // The camera optical frame in base_link: REP 103 optical axes (z forward
-  // = body x) and an offset; the same as ~camera_extrinsic in the launch.
-  Eigen::Isometry3d body_T_cam = Eigen::Isometry3d::Identity();
-  body_T_cam.linear() =
-      Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5).toRotationMatrix();
-  body_T_cam.translation() = Eigen::Vector3d(0.12, -0.03, 0.25);
-  const Eigen::Isometry3d cam_T_body = body_T_cam.inverse();
+const std::vector<std::string> kNodes = {"odom", "tfmsg", "pwc"};
 
-  tf2_ros::StaticTransformBroadcaster static_tf;
-  geometry_msgs::TransformStamped ext;
-  ext.header.stamp = ros::Time(kT0 - 10);
-  ext.header.frame_id = "base_link";
-  ext.child_frame_id = "camera_optical_frame";
-  {
+// The stream published once to the three nodes, and their depth views. The
+// subscriptions and the spinner stay up for the cases (the diagnostics keep
+// arriving). A step that does not complete ends the run; `failure` says
+// which.
+class PoseSourcesRun {
+  ros::NodeHandle nh_;  // first: the members below use it
+
+ public:
+  PoseSourcesRun() : diag(nh_), spinner_(2) {}
+  // No callback may run while the members it uses are destroyed.
+  ~PoseSourcesRun() { spinner_.stop(); }
+
+  void Run() {
+    scene = Render(RosTestSpec(kViews));
+    // The camera optical frame in base_link: REP 103 optical axes (z
+    // forward = body x) and an offset; the same as ~camera_extrinsic in the
+    // launch.
+    Eigen::Isometry3d body_T_cam = Eigen::Isometry3d::Identity();
+    body_T_cam.linear() =
+        Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5).toRotationMatrix();
+    body_T_cam.translation() = Eigen::Vector3d(0.12, -0.03, 0.25);
+    cam_T_body_ = body_T_cam.inverse();
+    geometry_msgs::TransformStamped ext;
+    ext.header.stamp = ros::Time(kT0 - 10);
+    ext.header.frame_id = "base_link";
+    ext.child_frame_id = "camera_optical_frame";
     const geometry_msgs::Pose p = PoseMsg(body_T_cam);
     ext.transform.translation.x = p.position.x;
     ext.transform.translation.y = p.position.y;
     ext.transform.translation.z = p.position.z;
     ext.transform.rotation = p.orientation;
-  }
-  static_tf.sendTransform(ext);
-
-  ros::Publisher odom_pub = nh.advertise<nav_msgs::Odometry>("/odometry", 200);
-  ros::Publisher tf_pub =
-      nh.advertise<geometry_msgs::TransformStamped>("/body_transform", 200);
-  ros::Publisher pwc_pub =
-      nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/camera_pose_cov",
-                                                             200);
-  ros::Publisher image_pub =
-      nh.advertise<sensor_msgs::Image>("/camera/image_raw", 10);
-  ros::Publisher info_pub =
-      nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 10);
-
-  const std::vector<std::string> nodes = {"odom", "tfmsg", "pwc"};
-  std::mutex mutex;
-  std::map<std::string, std::map<int, wild_mvs::DepthViewConstPtr>> views;
-  std::vector<ros::Subscriber> subs;
-  for (const std::string& node : nodes) {
-    subs.push_back(nh.subscribe<wild_mvs::DepthView>(
-        "/" + node + "/depth_view", 20,
-        [&, node](const wild_mvs::DepthViewConstPtr& m) {
-          const int i = static_cast<int>(
-              std::lround((m->header.stamp.toSec() - kT0) / kFramePeriod));
-          std::lock_guard<std::mutex> lock(mutex);
-          views[node][i] = m;
-        }));
-  }
-  DiagnosticsWatch diag(nh);
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  ASSERT_TRUE(WaitFor(
-      [&] {
-        for (const auto& s : subs)
-          if (s.getNumPublishers() == 0) return false;
-        return image_pub.getNumSubscribers() >= 3 &&
-               info_pub.getNumSubscribers() >= 3 &&
-               odom_pub.getNumSubscribers() >= 1 &&
-               tf_pub.getNumSubscribers() >= 1 &&
-               pwc_pub.getNumSubscribers() >= 1;
-      },
-      60));
-
-  // The stream in stamp order: poses from 0.1 s before the first image to
-  // 0.1 s after the last, images at their stamps.
-  const double t_end = (kViews - 1) * kFramePeriod + 0.1;
-  int next_image = 0;
-  const ros::WallTime wall0 = ros::WallTime::now();
-  for (double t = -0.1 + kPoseOffset; t <= t_end + 1e-9; t += kPosePeriod) {
-    while (next_image < kViews && next_image * kFramePeriod <= t) {
-      const double ti = next_image * kFramePeriod;
-      const Camera& cam = scene.scene.views[next_image].camera;
-      sensor_msgs::CameraInfo info = ros1::CameraInfoFromCamera(cam);
-      info.header.stamp = ros::Time(kT0 + ti);
-      info.header.frame_id = "camera_optical_frame";
-      sensor_msgs::Image im =
-          ros1::MatToMsg(ros1::LinearToSrgb8(scene.images[next_image]),
-                         sensor_msgs::image_encodings::RGB8);
-      im.header = info.header;
-      info_pub.publish(info);
-      image_pub.publish(im);
-      ++next_image;
+    static_tf_.sendTransform(ext);
+    Advertise();
+    spinner_.start();
+    if (!WaitFor(
+            [&] {
+              for (const auto& s : subs_)
+                if (s.getNumPublishers() == 0) return false;
+              return image_pub_.getNumSubscribers() >= 3 &&
+                     info_pub_.getNumSubscribers() >= 3 &&
+                     odom_pub_.getNumSubscribers() >= 1 &&
+                     tf_pub_.getNumSubscribers() >= 1 &&
+                     pwc_pub_.getNumSubscribers() >= 1;
+            },
+            60)) {
+      failure = "the three depth nodes did not come up";
+      return;
     }
+    PublishStream();
+    WaitFor(
+        [&] {
+          std::lock_guard<std::mutex> lock(mutex_);
+          for (const std::string& n : kNodes)
+            if (views_[n].size() < static_cast<size_t>(kViews - 1))
+              return false;
+          return true;
+        },
+        200);
+    complete = true;
+  }
+
+  std::map<int, wild_mvs::DepthViewConstPtr> Views(const std::string& node) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return views_[node];
+  }
+
+  SyntheticScene scene;
+  DiagnosticsWatch diag;
+  bool complete = false;
+  std::string failure;
+
+ private:
+  void Advertise() {
+    odom_pub_ = nh_.advertise<nav_msgs::Odometry>("/odometry", 200);
+    tf_pub_ =
+        nh_.advertise<geometry_msgs::TransformStamped>("/body_transform", 200);
+    pwc_pub_ = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>(
+        "/camera_pose_cov", 200);
+    image_pub_ = nh_.advertise<sensor_msgs::Image>("/camera/image_raw", 10);
+    info_pub_ =
+        nh_.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 10);
+    for (const std::string& node : kNodes) {
+      subs_.push_back(nh_.subscribe<wild_mvs::DepthView>(
+          "/" + node + "/depth_view", 20,
+          [this, node](const wild_mvs::DepthViewConstPtr& m) {
+            const int i = static_cast<int>(
+                std::lround((m->header.stamp.toSec() - kT0) / kFramePeriod));
+            std::lock_guard<std::mutex> lock(mutex_);
+            views_[node][i] = m;
+          }));
+    }
+  }
+
+  void PublishImage(int i) {
+    const Camera& cam = scene.scene.views[i].camera;
+    sensor_msgs::CameraInfo info = ros1::CameraInfoFromCamera(cam);
+    info.header.stamp = ros::Time(kT0 + i * kFramePeriod);
+    info.header.frame_id = "camera_optical_frame";
+    sensor_msgs::Image im = ros1::MatToMsg(ros1::LinearToSrgb8(scene.images[i]),
+                                           sensor_msgs::image_encodings::RGB8);
+    im.header = info.header;
+    info_pub_.publish(info);
+    image_pub_.publish(im);
+  }
+
+  // The body's pose at stream time t on each pose topic.
+  void PublishPoses(double t) {
     const Eigen::Isometry3d world_T_cam = CameraAt(scene, t);
-    const Eigen::Isometry3d world_T_body = world_T_cam * cam_T_body;
+    const Eigen::Isometry3d world_T_body = world_T_cam * cam_T_body_;
     std_msgs::Header h;
     h.stamp = ros::Time(kT0 + t);
     h.frame_id = "odom";
@@ -189,7 +213,7 @@ TEST(PoseSources, OdometryTransformAndPoseWithCovarianceAreInterpolated) {
     odom.header = h;
     odom.child_frame_id = "base_link";
     odom.pose.pose = PoseMsg(world_T_body);
-    odom_pub.publish(odom);
+    odom_pub_.publish(odom);
     geometry_msgs::TransformStamped tfm;
     tfm.header = h;
     tfm.child_frame_id = "base_link";
@@ -198,55 +222,113 @@ TEST(PoseSources, OdometryTransformAndPoseWithCovarianceAreInterpolated) {
     tfm.transform.translation.y = pb.position.y;
     tfm.transform.translation.z = pb.position.z;
     tfm.transform.rotation = pb.orientation;
-    tf_pub.publish(tfm);
+    tf_pub_.publish(tfm);
     geometry_msgs::PoseWithCovarianceStamped pwc;
     pwc.header = h;
     pwc.header.frame_id = "/odom";  // a leading slash, as old drivers send
     pwc.pose.pose = PoseMsg(world_T_cam);
-    pwc_pub.publish(pwc);
-    // Paced like a live stream (slowed down), by wall time.
-    const ros::WallTime due = wall0 + ros::WallDuration((t + 0.1) * kSlowdown);
-    const ros::WallDuration wait = due - ros::WallTime::now();
-    if (wait > ros::WallDuration(0)) wait.sleep();
+    pwc_pub_.publish(pwc);
   }
 
-  WaitFor(
-      [&] {
-        std::lock_guard<std::mutex> lock(mutex);
-        for (const std::string& n : nodes)
-          if (views[n].size() < static_cast<size_t>(kViews - 1)) return false;
-        return true;
-      },
-      200);
-  std::lock_guard<std::mutex> lock(mutex);
-  for (const std::string& node : nodes) {
-    SCOPED_TRACE(node);
-    EXPECT_GE(views[node].size(), static_cast<size_t>(kViews - 1))
-        << diag.Dump(node);
-    for (const auto& [i, msg] : views[node]) {
-      ASSERT_GE(i, 0);
-      ASSERT_LT(i, kViews);
-      Camera cam;
-      ros1::CameraFromCameraInfo(msg->camera_info, &cam, nullptr);
-      ros1::SetCameraPose(msg->camera_pose.pose, &cam);
-      const Camera& truth = scene.scene.views[i].camera;
-      EXPECT_LT((cam.Center() - truth.Center()).norm(), 5e-4) << "view " << i;
-      const double angle =
-          Eigen::AngleAxisd(cam.R * truth.R.transpose()).angle();
-      EXPECT_LT(angle, 2e-4) << "view " << i;
-      cv::Mat d = ros1::FloatImageFromMsg(msg->depth, 1, "depth");
-      d.forEach<float>([](float& v, const int*) {
-        if (std::isnan(v)) v = 0;
-      });
-      const DepthMetrics m = EvaluateDepth(d, cam, scene.depth[i], truth);
-      EXPECT_GT(m.completeness, 0.3) << "view " << i << ": " << m.ToString();
-      EXPECT_LT(m.median_rel_error, 0.01) << "view " << i;
+  // The stream in stamp order: poses from 0.1 s before the first image to
+  // 0.1 s after the last, images at their stamps; paced like a live stream
+  // (slowed down), by wall time.
+  void PublishStream() {
+    const double t_end = (kViews - 1) * kFramePeriod + 0.1;
+    int next_image = 0;
+    const ros::WallTime wall0 = ros::WallTime::now();
+    for (double t = -0.1 + kPoseOffset; t <= t_end + 1e-9; t += kPosePeriod) {
+      while (next_image < kViews && next_image * kFramePeriod <= t)
+        PublishImage(next_image++);
+      PublishPoses(t);
+      const ros::WallTime due =
+          wall0 + ros::WallDuration((t + 0.1) * kSlowdown);
+      const ros::WallDuration wait = due - ros::WallTime::now();
+      if (wait > ros::WallDuration(0)) wait.sleep();
     }
-    EXPECT_EQ(diag.Get(node, "frames dropped"), 0) << diag.Dump(node);
-    std::printf("[pose_sources] %s: %zu depth maps at the interpolated pose\n",
-                node.c_str(), views[node].size());
+  }
+
+  ros::AsyncSpinner spinner_;
+  tf2_ros::StaticTransformBroadcaster static_tf_;
+  Eigen::Isometry3d cam_T_body_;
+  ros::Publisher odom_pub_, tf_pub_, pwc_pub_, image_pub_, info_pub_;
+  std::vector<ros::Subscriber> subs_;
+  std::mutex mutex_;
+  std::map<std::string, std::map<int, wild_mvs::DepthViewConstPtr>> views_;
+};
+
+// One case per outcome and pose source (the parameter: the node's name).
+class PoseSources : public ::testing::TestWithParam<std::string> {
+ protected:
+  static void SetUpTestSuite() {
+    run_ = new PoseSourcesRun();
+    run_->Run();
+  }
+  static void TearDownTestSuite() {
+    delete run_;
+    run_ = nullptr;
+  }
+  void SetUp() override { ASSERT_TRUE(run_->complete) << run_->failure; }
+  static PoseSourcesRun* run_;
+};
+PoseSourcesRun* PoseSources::run_ = nullptr;
+
+TEST_P(PoseSources, EveryKeyframeGetsADepthView) {
+  const std::string& node = GetParam();
+  const auto views = run_->Views(node);
+  EXPECT_GE(views.size(), static_cast<size_t>(kViews - 1))
+      << run_->diag.Dump(node);
+  for (const auto& [i, msg] : views) {
+    EXPECT_GE(i, 0);
+    EXPECT_LT(i, kViews);
+  }
+  std::printf("[pose_sources] %s: %zu depth maps\n", node.c_str(),
+              views.size());
+}
+
+// The pose interpolated at the image stamp composed with the extrinsic (a
+// nearest pose would be 5 mm off at this speed).
+TEST_P(PoseSources, KeyframesAreAtTheCamerasTruePose) {
+  for (const auto& [i, msg] : run_->Views(GetParam())) {
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, kViews);
+    Camera cam;
+    ros1::CameraFromCameraInfo(msg->camera_info, &cam, nullptr);
+    ros1::SetCameraPose(msg->camera_pose.pose, &cam);
+    const Camera& truth = run_->scene.scene.views[i].camera;
+    EXPECT_LT((cam.Center() - truth.Center()).norm(), 5e-4) << "view " << i;
+    EXPECT_LT(Eigen::AngleAxisd(cam.R * truth.R.transpose()).angle(), 2e-4)
+        << "view " << i;
   }
 }
+
+TEST_P(PoseSources, DepthMapsMatchTheGroundTruth) {
+  for (const auto& [i, msg] : run_->Views(GetParam())) {
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, kViews);
+    Camera cam;
+    ros1::CameraFromCameraInfo(msg->camera_info, &cam, nullptr);
+    ros1::SetCameraPose(msg->camera_pose.pose, &cam);
+    cv::Mat d = ros1::FloatImageFromMsg(msg->depth, 1, "depth");
+    d.forEach<float>([](float& v, const int*) {
+      if (std::isnan(v)) v = 0;
+    });
+    const DepthMetrics m = EvaluateDepth(d, cam, run_->scene.depth[i],
+                                         run_->scene.scene.views[i].camera);
+    EXPECT_GT(m.completeness, 0.3) << "view " << i << ": " << m.ToString();
+    EXPECT_LT(m.median_rel_error, 0.01) << "view " << i;
+  }
+}
+
+TEST_P(PoseSources, NoFrameIsDropped) {
+  EXPECT_EQ(run_->diag.Get(GetParam(), "frames dropped"), 0)
+      << run_->diag.Dump(GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Sources, PoseSources, ::testing::ValuesIn(kNodes),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return info.param;
+                         });
 
 }  // namespace
 }  // namespace testing
