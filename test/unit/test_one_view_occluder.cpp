@@ -205,7 +205,7 @@ TEST(OneViewOccluder, ReconstructViewLeavesTheBoxEmpty) {
                 what, n.box, n.elsewhere, n.within);
   };
   MvsOptions off;
-  off.ablation.bilateral_window = false;  // the plain window, as measured
+  off.ablation.bilateral_window = false;  // the plain window isolates the test
   off.ablation.explain_test = false;
   const Count a = run(off);
   std::printf("view 0: %d box pixels\n", box_pixels);
