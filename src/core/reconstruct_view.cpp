@@ -39,7 +39,6 @@ MvsOptions PaperMvsOptions() {
   o.ablation.photometric_offset = false;
   o.ablation.consistency = false;
   o.ablation.planar_prior = false;
-  o.ablation.coarse_fill = false;
   return o;
 }
 

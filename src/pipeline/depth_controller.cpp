@@ -4,23 +4,13 @@
 #include <algorithm>
 #include <memory>
 
-#include "wild_mvs/core/coarse_fill.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/geometric_consistency.h"
-#include "wild_mvs/core/patch.h"
 #include "wild_mvs/core/stats.h"
 
 namespace wild_mvs {
 
 using Stage = DepthWorkspace::Stage;
-
-// The smallest coarse map (pixels, longest side): a coarse pass runs while
-// half the map's size is at least this. Measured at 640 px: a third level
-// (80 px) adds nothing (docs/METHODS.md, "Coarse fill").
-constexpr int kMinCoarseSize = 160;
-// Its four samples around a pixel lie on one surface when their planes agree
-// within this (relative depth along the pixel's ray).
-constexpr double kCoarseSpread = 0.01;
 using Step = DepthRunObserver::Step;
 
 DepthController::DepthController(const MvsOptions& options, ThreadPool* pool,
@@ -31,39 +21,10 @@ ViewResult DepthController::Match(const ViewProblem& problem) const {
   Require(problem.scene && problem.images, "a view problem needs a scene",
           " and its images");
   ViewResult r;
-  r.map = MatchAtScales(problem, options_, &r.report);
+  r.map = ReconstructView(*problem.scene, problem.ref, *problem.images,
+                          options_, pool_, &r.report, problem.mask,
+                          problem.points_per_view, cancel_);
   return r;
-}
-
-DepthMap DepthController::MatchAtScales(const ViewProblem& problem,
-                                        const MvsOptions& options,
-                                        ViewReport* report) const {
-  DepthMap map = ReconstructView(*problem.scene, problem.ref, *problem.images,
-                                 options, pool_, report, problem.mask,
-                                 problem.points_per_view, cancel_);
-  const int size = std::max(map.width(), map.height());
-  if (!options.ablation.coarse_fill || size / 2 < kMinCoarseSize) return map;
-  MvsOptions coarse = options;
-  coarse.max_image_size = size / 2;
-  ViewReport coarse_report;
-  const DepthMap c = MatchAtScales(problem, coarse, &coarse_report);
-  // Only where the full-size window cannot match at all.
-  std::shared_ptr<const cv::Mat> img =
-      problem.images->GetResized(problem.ref, map.width(), map.height());
-  cv::Mat image = img->isContinuous() ? *img : img->clone();
-  MatchImage view;
-  view.data = image.ptr<float>();
-  view.width = image.cols;
-  view.height = image.rows;
-  view.channels = 3;
-  const cv::Mat fillable =
-      WindowsBelowNoise(image, NoiseProfile::Estimate(view),
-                        options.mpgc.window, options.mpgc.drop_ncc);
-  report->coarse_samples =
-      FillFromCoarse(c, kCoarseSpread, options.mpgc.window / 2, fillable, &map);
-  report->samples += report->coarse_samples;
-  report->pixel_visits += coarse_report.pixel_visits;
-  return map;
 }
 
 ViewResult DepthController::Filter(const DepthMap& raw,
