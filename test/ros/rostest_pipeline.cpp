@@ -42,7 +42,10 @@ class PipelineRun {
  public:
   PipelineRun() : diag(nh_), spinner_(2) {}
   // No callback may run while the members it uses are destroyed.
-  ~PipelineRun() { spinner_.stop(); }
+  ~PipelineRun() {
+    spinner_.stop();
+    if (!dir.empty()) std::filesystem::remove_all(dir);
+  }
 
   void Run() {
     scene = Render(RosTestSpec(kViews));
@@ -172,26 +175,14 @@ class PipelineRun {
   ros::Subscriber depth_sub_, view_sub_, cloud_sub_, mesh_sub_;
 };
 
-class Pipeline : public ::testing::Test {
+class Pipeline : public RunOnce<PipelineRun> {
  protected:
-  static void SetUpTestSuite() {
-    run_ = new PipelineRun();
-    run_->Run();
-  }
-  static void TearDownTestSuite() {
-    if (!run_->dir.empty()) std::filesystem::remove_all(run_->dir);
-    delete run_;
-    run_ = nullptr;
-  }
-  void SetUp() override { ASSERT_TRUE(run_->complete) << run_->failure; }
   static CloudMetrics AgainstTruth(const PointCloud& cloud) {
     CloudMetricsOptions co;
     co.taus = {0.02, 0.04};
     return EvaluateCloud(cloud, run_->scene.GroundTruthCloud(1), co);
   }
-  static PipelineRun* run_;
 };
-PipelineRun* Pipeline::run_ = nullptr;
 
 TEST_F(Pipeline, EveryKeyframeGetsADepthImageAndADepthView) {
   const auto views = run_->Views();

@@ -257,21 +257,17 @@ class PoseSourcesRun {
   std::map<std::string, std::map<int, wild_mvs::DepthViewConstPtr>> views_;
 };
 
+// The camera a depth view names: its camera_info at its pose.
+Camera CameraOf(const wild_mvs::DepthView& m) {
+  Camera cam;
+  ros1::CameraFromCameraInfo(m.camera_info, &cam, nullptr);
+  ros1::SetCameraPose(m.camera_pose.pose, &cam);
+  return cam;
+}
+
 // One case per outcome and pose source (the parameter: the node's name).
-class PoseSources : public ::testing::TestWithParam<std::string> {
- protected:
-  static void SetUpTestSuite() {
-    run_ = new PoseSourcesRun();
-    run_->Run();
-  }
-  static void TearDownTestSuite() {
-    delete run_;
-    run_ = nullptr;
-  }
-  void SetUp() override { ASSERT_TRUE(run_->complete) << run_->failure; }
-  static PoseSourcesRun* run_;
-};
-PoseSourcesRun* PoseSources::run_ = nullptr;
+using PoseSources =
+    RunOnce<PoseSourcesRun, ::testing::TestWithParam<std::string>>;
 
 TEST_P(PoseSources, EveryKeyframeGetsADepthView) {
   const std::string& node = GetParam();
@@ -292,9 +288,7 @@ TEST_P(PoseSources, KeyframesAreAtTheCamerasTruePose) {
   for (const auto& [i, msg] : run_->Views(GetParam())) {
     ASSERT_GE(i, 0);
     ASSERT_LT(i, kViews);
-    Camera cam;
-    ros1::CameraFromCameraInfo(msg->camera_info, &cam, nullptr);
-    ros1::SetCameraPose(msg->camera_pose.pose, &cam);
+    const Camera cam = CameraOf(*msg);
     const Camera& truth = run_->scene.scene.views[i].camera;
     EXPECT_LT((cam.Center() - truth.Center()).norm(), 5e-4) << "view " << i;
     EXPECT_LT(Eigen::AngleAxisd(cam.R * truth.R.transpose()).angle(), 2e-4)
@@ -306,9 +300,7 @@ TEST_P(PoseSources, DepthMapsMatchTheGroundTruth) {
   for (const auto& [i, msg] : run_->Views(GetParam())) {
     ASSERT_GE(i, 0);
     ASSERT_LT(i, kViews);
-    Camera cam;
-    ros1::CameraFromCameraInfo(msg->camera_info, &cam, nullptr);
-    ros1::SetCameraPose(msg->camera_pose.pose, &cam);
+    const Camera cam = CameraOf(*msg);
     cv::Mat d = ros1::FloatImageFromMsg(msg->depth, 1, "depth");
     d.forEach<float>([](float& v, const int*) {
       if (std::isnan(v)) v = 0;

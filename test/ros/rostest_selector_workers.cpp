@@ -41,7 +41,10 @@ class SelectorWorkersRun {
  public:
   SelectorWorkersRun() : diag(nh_), spinner_(2) {}
   // No callback may run while the members it uses are destroyed.
-  ~SelectorWorkersRun() { spinner_.stop(); }
+  ~SelectorWorkersRun() {
+    spinner_.stop();
+    if (!dir.empty()) std::filesystem::remove_all(dir);
+  }
 
   void Run() {
     const SyntheticScene scene = Render(RosTestSpec(kViews));
@@ -164,22 +167,10 @@ class SelectorWorkersRun {
 
 // The cases run in the order written: the last one publishes faults that
 // change the fusion node's counts the one before checks.
-class SelectorWorkers : public ::testing::Test {
+class SelectorWorkers : public RunOnce<SelectorWorkersRun> {
  protected:
-  static void SetUpTestSuite() {
-    run_ = new SelectorWorkersRun();
-    run_->Run();
-  }
-  static void TearDownTestSuite() {
-    if (!run_->dir.empty()) std::filesystem::remove_all(run_->dir);
-    delete run_;
-    run_ = nullptr;
-  }
-  void SetUp() override { ASSERT_TRUE(run_->complete) << run_->failure; }
   static long Keyframes() { return static_cast<long>(run_->selected.size()); }
-  static SelectorWorkersRun* run_;
 };
-SelectorWorkersRun* SelectorWorkers::run_ = nullptr;
 
 // The precondition of what follows: worker 1 missed keyframes.
 TEST_F(SelectorWorkers, RelayDroppedKeyframesOfWorker1) {

@@ -35,7 +35,10 @@ class TwoWorkersRun {
  public:
   TwoWorkersRun() : diag(nh_), spinner_(2) {}
   // No callback may run while the members it uses are destroyed.
-  ~TwoWorkersRun() { spinner_.stop(); }
+  ~TwoWorkersRun() {
+    spinner_.stop();
+    if (!dir.empty()) std::filesystem::remove_all(dir);
+  }
 
   void Run() {
     const SyntheticScene scene = Render(RosTestSpec(kViews));
@@ -162,18 +165,8 @@ class TwoWorkersRun {
   std::vector<ros::Subscriber> subs_;
 };
 
-class TwoWorkers : public ::testing::Test {
+class TwoWorkers : public RunOnce<TwoWorkersRun> {
  protected:
-  static void SetUpTestSuite() {
-    run_ = new TwoWorkersRun();
-    run_->Run();
-  }
-  static void TearDownTestSuite() {
-    if (!run_->dir.empty()) std::filesystem::remove_all(run_->dir);
-    delete run_;
-    run_ = nullptr;
-  }
-  void SetUp() override { ASSERT_TRUE(run_->complete) << run_->failure; }
   // Fraction of p's points with a point of q within tau metres.
   static double Within(const PointCloud& p, const PointCloud& q, double tau) {
     const std::vector<double> d = NearestDistances(p, q, 2);
@@ -181,9 +174,7 @@ class TwoWorkers : public ::testing::Test {
                          [tau](double x) { return x <= tau; }) /
            double(d.size());
   }
-  static TwoWorkersRun* run_;
 };
-TwoWorkersRun* TwoWorkers::run_ = nullptr;
 
 TEST_F(TwoWorkers, SameKeyframesAsOneWorker) {
   EXPECT_EQ(run_->keyframes_one, run_->keyframes_two);

@@ -26,6 +26,28 @@
 namespace wild_mvs {
 namespace testing {
 
+// The fixture of a rostest whose cases check what one scenario produced:
+// `Run` (with Run(), `complete` and `failure`) is run once before the first
+// case and deleted after the last; every case fails at once, with the
+// reason, when the run did not complete. Base: ::testing::Test, or
+// ::testing::TestWithParam<T> for cases per parameter.
+template <typename Run, typename Base = ::testing::Test>
+class RunOnce : public Base {
+ protected:
+  static void SetUpTestSuite() {
+    run_ = new Run();
+    run_->Run();
+  }
+  static void TearDownTestSuite() {
+    delete run_;
+    run_ = nullptr;
+  }
+  void SetUp() override { ASSERT_TRUE(run_->complete) << run_->failure; }
+  static Run* run_;
+};
+template <typename Run, typename Base>
+Run* RunOnce<Run, Base>::run_ = nullptr;
+
 // Latest diagnostics values per status name ("depth_node: depth_node").
 class DiagnosticsWatch {
  public:
