@@ -40,7 +40,7 @@
 # fountain needs it, temple uses its GT model when present), BUILD_DIR
 # (default build-bench), OPENMVS_BIN. (MVE: recorded figures only; no
 # runner for dmrecon and its .mvei depth maps yet.)
-# Installs what it needs (scripts/install_deps.sh --no-ros --bench: the
+# Installs what it needs (scripts/install_deps.sh --no-ros --tests --bench: the
 # build dependencies, time, bc, python3-matplotlib) unless --skip-build.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -67,7 +67,7 @@ for s in ${SKIP//,/ }; do
   esac
 done
 skipped() { [[ ",$SKIP," == *",$1,"* ]]; }
-[ "$BUILD" = 0 ] || bash "$ROOT/scripts/install_deps.sh" --no-ros --bench
+[ "$BUILD" = 0 ] || bash "$ROOT/scripts/install_deps.sh" --no-ros --tests --bench
 for tool in /usr/bin/time bc; do
   command -v "$tool" >/dev/null || { echo "run_all.sh: needs $tool (apt-get install time bc)" >&2; exit 1; }
 done

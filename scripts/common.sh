@@ -32,8 +32,12 @@ if command -v ccache >/dev/null 2>&1; then
   CCACHE_ARGS=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
 
+# The scripts' builds are unity builds (CMake joins up to 8 sources of a
+# target into one compile): half the compile time of a fresh build. The
+# sanitizer build below compiles every source on its own, so both ways are
+# built and tested.
 wild_mvs_configure() {  # extra cmake args...
-  cmake -S "$WILD_MVS_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${CCACHE_ARGS[@]}" \
+  cmake -S "$WILD_MVS_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON "${CCACHE_ARGS[@]}" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@" >"$BUILD_DIR.cmake.log" 2>&1 \
     || { cat "$BUILD_DIR.cmake.log"; return 1; }
 }

@@ -14,7 +14,7 @@
 # Usage: scripts/run_tests.sh
 set -eo pipefail
 source "$(dirname "$0")/common.sh"
-bash "$WILD_MVS_ROOT/scripts/install_deps.sh" --extra
+bash "$WILD_MVS_ROOT/scripts/install_deps.sh" --tests --extra
 mkdir -p "$BUILD_DIR"
 # Everything, with the tests and the ROS nodes (the demo's build folder
 # may have been configured without them).
