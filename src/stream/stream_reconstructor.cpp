@@ -386,7 +386,6 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
   if (std::none_of(all.begin(), all.end(), schedulable)) return;
   ++stats_.scheduling_passes;
   const Snapshot snap = MakeSnapshotLocked();
-  const uint32_t newest = store_.Newest()->id;
   for (size_t i = 0; i < snap.keyframes.size(); ++i) {
     const KeyframePtr& kf = snap.keyframes[i];
     if (!kf->owned || in_flight_.count(kf->id)) continue;
@@ -396,10 +395,6 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
     if (nb.good <
         std::max(options_.min_neighbors, options_.mvs.mpgc.min_active_views))
       continue;
-    const bool ready =
-        static_cast<int>(newest - kf->id) >= options_.lookahead ||
-        nb.good >= options_.mvs.global.num_neighbors || idle;
-    if (!ready) continue;
     if (static_cast<int>(in_flight_.size()) >= options_.max_pending) {
       ++ready_waiting_;  // ready, waits for a free slot
       continue;
@@ -426,16 +421,37 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
     return rematched ? rematched_.count(n) > 0
                      : k->done() && !in_flight_.count(n);
   };
+  const KeyframePtr newest = store_.Newest();
+  // A full neighbourhood, as offline: the store holds as many other
+  // keyframes as the view selection picks.
+  const bool full_store = static_cast<int>(store_.size()) >
+                          std::min(options_.mvs.global.num_neighbors,
+                                   options_.store.max_keyframes - 1);
   for (const auto& [id, pending] : unrevised_) {
     // Step 1, matching again, once the neighbours of the first match are
-    // matched; step 2, the filter, once the new neighbours are matched
-    // again too (their maps are then what the offline filter would see).
-    // At the idle flush nothing is waited for.
+    // matched, the store holds a full neighbourhood and the keyframes up to
+    // `lookahead` after it have `lookahead` later keyframes themselves (the
+    // sparse tracks through its neighbours on both sides are then as the
+    // offline tracker would have them); step 2, the filter, once the new
+    // neighbours are matched again too (their maps are then what the
+    // offline filter would see). At the idle flush nothing is waited for.
     const bool rematched = rematched_.count(id) > 0;
-    bool ready = true;
+    bool ready = rematched ||
+                 (full_store && newest &&
+                  static_cast<int64_t>(newest->id) - static_cast<int64_t>(id) >=
+                      2 * options_.lookahead);
     for (uint32_t n : pending.neighbor_ids)
       if (n != id && !settled(n, rematched)) ready = false;
     if (!ready && !idle) continue;
+    // Even at the idle flush, the filter never judges against a
+    // neighbour's preview when that neighbour is still to be matched again.
+    if (rematched &&
+        std::any_of(pending.neighbor_ids.begin(), pending.neighbor_ids.end(),
+                    [this, id](uint32_t n) {
+                      return n != id && unrevised_.count(n) &&
+                             !rematched_.count(n);
+                    }))
+      continue;
     revising_.insert(id);
     const uint64_t gen = generation_;
     const uint32_t rid = id;
@@ -639,6 +655,16 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     mvs = options_.mvs;  // SetOptions may change it meanwhile
     ++stats_.running;
   }
+  // With a revision to follow, the first map is a preview at half the
+  // working size (a quarter of the pixels): out fast, replaced by the
+  // full-size revision.
+  if (mvs.ablation.consistency) {
+    const int longest = std::max(kf->image.cols, kf->image.rows);
+    const int working = mvs.max_image_size > 0
+                            ? std::min(longest, mvs.max_image_size)
+                            : longest;
+    if (working / 2 >= kMinPreviewSize) mvs.max_image_size = working / 2;
+  }
   StreamResult result;
   result.keyframe_id = id;
   result.session = session;
@@ -828,12 +854,13 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(1);
   registry
       ->Add(key("lookahead"), &o->lookahead,
-            "... and this many later keyframes (or idle_flush s without one)")
+            "a revision waits until the keyframes up to this many after "
+            "it have this many later keyframes (or idle_flush s without one)")
       .Min(0);
   registry
       ->Add(key("idle_flush"), &o->idle_flush,
-            "s without a new keyframe after which ready keyframes are "
-            "reconstructed")
+            "s without a new keyframe after which waiting keyframes are "
+            "matched and revised")
       .Min(0);
   registry
       ->Add(key("worker_index"), &o->worker_index,

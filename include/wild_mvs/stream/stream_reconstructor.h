@@ -15,9 +15,12 @@
 // Revisions: the offline pipeline's steps, live. A keyframe is matched as
 // soon as it has enough neighbours, mostly earlier ones, and that map is
 // delivered at once (revision 0). With the consistency step on
-// (mvs.ablation.consistency, as offline) it is then revised once, when
-// every neighbour it was matched against is done (matched by this worker,
-// owned by another, failed or evicted; or at the idle flush): matched again
+// (mvs.ablation.consistency, as offline) that first map is a preview at
+// half the working size, and it is revised once, when every neighbour it
+// was matched against is done (matched by this worker, owned by another,
+// failed or evicted), the store holds mvs.global.num_neighbors other
+// keyframes and the keyframes after it are tracked (`lookahead`; or at the
+// idle flush): matched again at the working size
 // over every keyframe held, so with neighbours on both sides as offline;
 // once those neighbours are matched again too (or at the idle flush), it is
 // checked against their maps (FilterByConsistency with mvs.consistency, the
@@ -57,6 +60,9 @@ namespace wild_mvs {
 // A frame stamped more than this many seconds before the previous one
 // resets the stream (a bag loop); smaller steps back are dropped.
 constexpr double kStampResetSeconds = 1.0;
+// A keyframe's first map is matched at half the working size when that is
+// at least this many pixels (longest side) and a revision follows.
+constexpr int kMinPreviewSize = 64;
 
 struct StreamOptions {
   KeyframeSelectionOptions keyframes;
@@ -76,9 +82,11 @@ struct StreamOptions {
   // Good neighbours before reconstructing (at least
   // mvs.mpgc.min_active_views, which MPGC needs).
   int min_neighbors = 3;
-  // Reconstruct once `lookahead` later keyframes arrived (so neighbours on
-  // both sides exist) or after `idle_flush` s (wall time) without a new
-  // keyframe, or when mvs.global.num_neighbors good neighbours are there.
+  // A keyframe is matched as soon as it has min_neighbors good neighbours.
+  // Its revision waits until the keyframes up to `lookahead` after it have
+  // `lookahead` later keyframes themselves and the store holds
+  // mvs.global.num_neighbors other keyframes, or for `idle_flush` s (wall
+  // time) without a new keyframe.
   int lookahead = 2;
   double idle_flush = 1.0;
   // Longest image side kept, pixels, 0 or >= 16 (input downscaled at
