@@ -445,16 +445,16 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
     if (!ready && !idle) continue;
     // Even at the idle flush, the filter never judges against a
     // neighbour's preview when that neighbour is still to be matched again.
+    const uint32_t rid = id;
     if (rematched &&
         std::any_of(pending.neighbor_ids.begin(), pending.neighbor_ids.end(),
-                    [this, id](uint32_t n) {
-                      return n != id && unrevised_.count(n) &&
+                    [this, rid](uint32_t n) {
+                      return n != rid && unrevised_.count(n) &&
                              !rematched_.count(n);
                     }))
       continue;
     revising_.insert(id);
     const uint64_t gen = generation_;
-    const uint32_t rid = id;
     dispatcher_->Submit([this, rid, gen, rematched] {
       if (rematched) {
         RunRevisionFilter(rid, gen);
