@@ -75,12 +75,15 @@ def main():
             print(f"{name}: map size differs from the ground truth; skipped")
             continue
         valid = np.isfinite(gt) & (gt > 0)
-        sky_b = np.isfinite(b) & (b > 0) & ~valid & ~(np.isfinite(a) & (a > 0))
+        est_a = np.isfinite(a) & (a > 0)
+        est_b = np.isfinite(b) & (b > 0)
+        sky_b = est_b & ~est_a & ~valid
         if sky_b.any():
-            for d in distance_to_surface(valid)[sky_b]:
-                sky_added[int(d)] = sky_added.get(int(d), 0) + 1
-        has_a = np.isfinite(a) & (a > 0) & valid
-        has_b = np.isfinite(b) & (b > 0) & valid
+            counts = np.bincount(distance_to_surface(valid)[sky_b])
+            for d in np.nonzero(counts)[0]:
+                sky_added[int(d)] = sky_added.get(int(d), 0) + int(counts[d])
+        has_a = est_a & valid
+        has_b = est_b & valid
         for key, mask, d in (("both: A", has_a & has_b, a),
                              ("both: B", has_a & has_b, b),
                              ("A only", has_a & ~has_b, a),
