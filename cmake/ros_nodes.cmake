@@ -21,7 +21,8 @@ add_dependencies(wild_mvs_ros ${PROJECT_NAME}_generate_messages_cpp
 
 # --- nodes and tools ---------------------------------------------------------
 set(WILD_MVS_ROS_EXECUTABLES)
-foreach(name depth_node fusion_node wild_mvs_to_bag)
+foreach(name depth_node keyframe_selector_node depth_worker_node fusion_node
+    wild_mvs_to_bag)
   if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/nodes/${name}.cpp)
     add_executable(${name} src/nodes/${name}.cpp)
     target_link_libraries(${name} PRIVATE wild_mvs_ros)
@@ -29,7 +30,7 @@ foreach(name depth_node fusion_node wild_mvs_to_bag)
     list(APPEND WILD_MVS_ROS_EXECUTABLES ${name})
   endif()
 endforeach()
-# Writes config/{reconstruct,depth_node,fusion_node}.yaml from the option
+# Writes config/*.yaml (reconstruct, the depth roles, fusion) from the option
 # registry (`wild_mvs_write_config config`; the test config_files compares).
 add_executable(wild_mvs_write_config src/tools/write_config.cpp)
 target_link_libraries(wild_mvs_write_config PRIVATE wild_mvs_ros wild_mvs_cli)

@@ -98,6 +98,7 @@ void DepthInputs::Subscribe(FrameFn on_frame, PointsFn on_points) {
 void DepthInputs::OnRaw(const sensor_msgs::ImageConstPtr& msg) {
   DepthFrame f;
   f.raw = msg;
+  f.rectified = rectified_;
   f.stamp = msg->header.stamp;
   f.frame_id = msg->header.frame_id;
   on_frame_(std::move(f));
@@ -107,6 +108,7 @@ void DepthInputs::OnCompressed(
     const sensor_msgs::CompressedImageConstPtr& msg) {
   DepthFrame f;
   f.compressed = msg;
+  f.rectified = rectified_;
   f.stamp = msg->header.stamp;
   f.frame_id = msg->header.frame_id;
   on_frame_(std::move(f));
@@ -260,7 +262,7 @@ bool DepthInputs::PairCameraInfo(DepthFrame* f) {
 bool DepthInputs::CameraFromInfo(const DepthFrame& f, Camera* cam) {
   Distortion dist;
   try {
-    CameraFromCameraInfo(*f.info, cam, &dist, rectified_);
+    CameraFromCameraInfo(*f.info, cam, &dist, f.rectified);
   } catch (const Error& e) {
     drop_(info_topic_, "invalid camera_info", e.what());
     return false;
@@ -288,7 +290,7 @@ bool DepthInputs::ConvertImage(const DepthFrame& f, Camera* cam,
   // input passes through: the camera is P's, without distortion).
   try {
     Distortion d;
-    CameraFromCameraInfo(*f.info, cam, &d, rectified_);
+    CameraFromCameraInfo(*f.info, cam, &d, f.rectified);
     *image = undistorter_->Apply(*cam, d, *image);
   } catch (const Error& e) {
     drop_(info_topic_, "invalid camera_info", e.what());

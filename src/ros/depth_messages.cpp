@@ -120,11 +120,11 @@ void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
   }
   // (A lost keyframe is also a drop: WARN while recent.)
-  stat.add("role", in.role);
-  if (in.role == "selector") {
+  stat.add("role", RoleName(in.role));
+  if (in.role == DepthRole::kSelector) {
     stat.add("keyframes published", in.keyframes_published);
     stat.add("keyframes served", in.keyframes_served);
-  } else if (in.role == "worker") {
+  } else if (in.role == DepthRole::kWorker) {
     stat.add("keyframes received", in.keyframes_received);
     stat.add("keyframes fetched", in.keyframes_fetched);
     stat.add("keyframes lost", in.keyframes_lost);

@@ -33,7 +33,7 @@ struct DepthNode::Impl {
   DepthNodeOptions options;
   DropCounter drops;
   std::unique_ptr<DepthInputs> inputs;
-  std::unique_ptr<DepthOutputs> outputs;
+  std::unique_ptr<DepthOutputs> outputs;  // not a selector's
   std::unique_ptr<StreamReconstructor> stream;
   // Callbacks only queue frames (bounded, the oldest dropped and counted);
   // the queue's thread is the front end: it converts them and feeds the
@@ -50,7 +50,7 @@ struct DepthNode::Impl {
   std::unique_ptr<DepthLiveParams> live_params;
   ros::ServiceServer reset_srv;
   RoscppDropWatch roscpp_drops;  // roscpp's own queue drops, into `drops`
-  // The roles (~role): a selector's announcer, a worker's keyframe input.
+  // The roles: a selector's announcer, a worker's keyframe input.
   std::unique_ptr<KeyframeAnnouncer> announcer;
   std::unique_ptr<DepthWorkerInput> worker;
   ros::SteadyTimer index_timer;
@@ -120,12 +120,13 @@ struct DepthNode::Impl {
   }
 };
 
-DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
+DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                     DepthRole role)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.nh = nh;
   m.pnh = pnh;
-  m.options = LoadDepthNodeOptions(pnh);
+  m.options = LoadDepthNodeOptions(pnh, role);
   auto drop = [&m](const std::string& topic, const std::string& problem,
                    const std::string& detail) {
     m.Drop(topic, problem, detail);
@@ -148,12 +149,13 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   m.map_rate = std::make_unique<RateStatus>(
       "rate: depth maps", 0.0, inf, 10, diagnostic_msgs::DiagnosticStatus::OK,
       "no depth map in the last 10 diagnostics periods (no new keyframe)");
-  m.outputs = std::make_unique<DepthOutputs>(
-      m.pnh, o.world_frame, o.depth_encoding, o.stream.worker_index);
+  if (Reconstructs(role))  // a selector publishes no depth
+    m.outputs = std::make_unique<DepthOutputs>(
+        m.pnh, o.world_frame, o.depth_encoding, o.stream.worker_index);
   m.stream = std::make_unique<StreamReconstructor>(
       o.stream,
       [&m](const StreamResult& r) {
-        m.outputs->Publish(r);
+        if (m.outputs) m.outputs->Publish(r);
         if (m.map_rate) m.map_rate->tick();
       },
       [&m](const std::string& e) {
@@ -161,9 +163,9 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       });
   // A worker's queue holds keyframes (a few per second at most).
   m.queue = std::make_unique<WorkQueue<DepthFrame>>(
-      o.role == "worker" ? kKeyframeQueueSize : o.input_queue_size,
+      role == DepthRole::kWorker ? kKeyframeQueueSize : o.input_queue_size,
       [&m](DepthFrame f) { m.FrontEnd(std::move(f)); });
-  if (o.role == "selector") {
+  if (role == DepthRole::kSelector) {
     m.announcer = std::make_unique<KeyframeAnnouncer>(m.pnh, o.world_frame,
                                                       kKeyframeHistory);
     m.index_timer = m.nh.createSteadyTimer(
@@ -174,7 +176,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
                                                 m.inputs.get(), m.stream.get(),
                                                 m.announcer.get(), drop);
   auto enqueue = [&m](DepthFrame f) { m.Enqueue(std::move(f)); };
-  if (o.role == "worker") {
+  if (role == DepthRole::kWorker) {
     m.worker = std::make_unique<DepthWorkerInput>(
         m.nh, m.options, m.inputs.get(), drop,
         [&m](const WorkerKeyframe& k) { m.front_end->TakeKeyframe(k); });
@@ -202,7 +204,7 @@ DepthNode::DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       [&m](const StreamOptions& live) { m.stream->SetOptions(live); });
   m.reset_srv = m.pnh.advertiseService("reset", &Impl::OnReset, &m);
   m.queue->Start();  // the front-end thread
-  std::string what = o.role == "selector"
+  std::string what = role == DepthRole::kSelector
                          ? "keyframe selector (~keyframes)"
                          : Msg("worker ", o.stream.worker_index, " of ",
                                o.stream.worker_count);
@@ -227,15 +229,16 @@ DepthNode::~DepthNode() {
   m.stream.reset();
 }
 
-// The nodelet: the same node inside a nodelet manager.
-class DepthNodelet : public nodelet::Nodelet {
+// The nodelets: the node of one role inside a nodelet manager.
+template <DepthRole kRole>
+class DepthRoleNodelet : public nodelet::Nodelet {
  private:
   void onInit() override {
     try {
       // Multi-threaded callback queues (image, camera_info and pose
       // callbacks, timers and services never wait for one another).
       node_ = std::make_unique<DepthNode>(getMTNodeHandle(),
-                                          getMTPrivateNodeHandle());
+                                          getMTPrivateNodeHandle(), kRole);
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
       throw;
@@ -244,7 +247,15 @@ class DepthNodelet : public nodelet::Nodelet {
   std::unique_ptr<DepthNode> node_;
 };
 
+class DepthNodelet : public DepthRoleNodelet<DepthRole::kStandalone> {};
+class KeyframeSelectorNodelet : public DepthRoleNodelet<DepthRole::kSelector> {
+};
+class DepthWorkerNodelet : public DepthRoleNodelet<DepthRole::kWorker> {};
+
 }  // namespace ros1
 }  // namespace wild_mvs
 
 PLUGINLIB_EXPORT_CLASS(wild_mvs::ros1::DepthNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(wild_mvs::ros1::KeyframeSelectorNodelet,
+                       nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(wild_mvs::ros1::DepthWorkerNodelet, nodelet::Nodelet)

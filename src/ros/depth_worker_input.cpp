@@ -74,6 +74,7 @@ void DepthWorkerInput::Take(const wild_mvs::SelectedKeyframeConstPtr& k) {
     return;
   }
   f.info = sensor_msgs::CameraInfoConstPtr(k, &k->camera_info);
+  f.rectified = k->rectified;
   if (!inputs_->CameraFromInfo(f, &w.camera)) return;
   try {
     SetCameraPose(k->camera_pose.pose, &w.camera);

@@ -66,6 +66,7 @@ void KeyframeAnnouncer::Publish(
   if (f.raw) msg->image = *f.raw;
   if (f.compressed) msg->compressed = *f.compressed;
   msg->camera_info = *f.info;
+  msg->rectified = f.rectified;
   msg->camera_pose.header.stamp = msg->header.stamp;
   msg->camera_pose.header.frame_id = world_frame_;
   msg->camera_pose.pose = PoseFromCamera(camera);

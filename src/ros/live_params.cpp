@@ -226,13 +226,16 @@ DepthLiveParams::DepthLiveParams(
     std::function<void(const StreamOptions&)> apply)
     : live_(options) {
   RegisterOptions(&registry_, "", &live_);
-  params_ = std::make_unique<LiveParams>(
-      private_nh, &registry_,
-      std::vector<std::string>{
-          "keyframe_min_baseline", "keyframe_min_angle_deg",
-          "mvs.max_image_size", "mvs.global.num_neighbors", "mvs.local.min_ncc",
-          "mvs.mpgc.drop_ncc", "mvs.growing.revisit_margin"},
-      [this, apply] {
+  // Those of the node's role (a worker selects no keyframes, a selector
+  // matches nothing).
+  std::vector<std::string> keys;
+  for (const char* k :
+       {"keyframe_min_baseline", "keyframe_min_angle_deg", "mvs.max_image_size",
+        "mvs.global.num_neighbors", "mvs.local.min_ncc", "mvs.mpgc.drop_ncc",
+        "mvs.growing.revisit_margin"})
+    if (registry_.Has(k)) keys.push_back(k);
+  params_ =
+      std::make_unique<LiveParams>(private_nh, &registry_, keys, [this, apply] {
         live_.Check();
         apply(live_.stream);
       });

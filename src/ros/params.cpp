@@ -129,13 +129,35 @@ void DepthNodeOptions::Check() const {
           "input_queue_size = ", input_queue_size, " must be in [1, 1000]");
   Require(std::isfinite(diagnostics_period) && diagnostics_period > 0,
           "diagnostics_period = ", diagnostics_period, " must be > 0");
-  Require(role == "standalone" || role == "selector" || role == "worker",
-          "role = '", role, "' must be 'standalone', 'selector' or 'worker'");
   // Keyframes are kept at this size (StreamOptions::max_image_size).
   Require(stream.mvs.max_image_size == 0 || stream.mvs.max_image_size >= 16,
           "mvs.max_image_size = ", stream.mvs.max_image_size,
           " must be 0 (as received) or >= 16");
   stream.Check();
+}
+
+const char* RoleName(DepthRole role) {
+  switch (role) {
+    case DepthRole::kSelector:
+      return "selector";
+    case DepthRole::kWorker:
+      return "worker";
+    case DepthRole::kStandalone:
+      break;
+  }
+  return "standalone";
+}
+
+const char* ConfigFileName(DepthRole role) {
+  switch (role) {
+    case DepthRole::kSelector:
+      return "keyframe_selector.yaml";
+    case DepthRole::kWorker:
+      return "depth_worker.yaml";
+    case DepthRole::kStandalone:
+      break;
+  }
+  return "depth_node.yaml";
 }
 
 Eigen::Isometry3d ParseCameraExtrinsic(const std::string& text) {
@@ -188,65 +210,69 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       ->Add(key("world_frame"), &o->world_frame,
             "fixed frame of the poses (REP 105)")
       .Note("not empty");
-  registry
-      ->Add(key("pose_source"), &o->pose_source,
+  if (ReadsCamera(o->role)) {
+    registry
+        ->Add(
+            key("pose_source"), &o->pose_source,
             "tf: world_frame <- image frame_id at the image stamp; on `pose`, "
             "interpolated at the image stamp: pose (PoseStamped; topic = the "
             "same), pose_with_covariance, transform (TransformStamped), "
             "odometry (nav_msgs/Odometry)")
-      .OneOf({"tf", "topic", "pose", "pose_with_covariance", "transform",
-              "odometry"});
-  registry->Add(key("pose_frame"), &o->pose_frame,
-                "frame the topic poses are of; \"\" = the camera (pose), the "
-                "child_frame_id (transform, odometry); a body frame needs "
-                "camera_extrinsic or tf body <- camera");
-  registry
-      ->Add(key("camera_extrinsic"), &o->camera_extrinsic,
-            "T_body_camera \"x y z qx qy qz qw\"; \"\" = from tf "
-            "(/tf_static)")
-      .Note("\"\" or 7 numbers");
-  registry
-      ->Add(key("tf_timeout"), &o->tf_timeout,
-            "s to wait for the pose of a frame")
-      .Min(0)
-      .Max(60);
-  registry->Add(key("camera_frame"), &o->camera_frame,
-                "camera optical frame; \"\" = the image header's frame_id");
-  registry
-      ->Add(key("image_transport"), &o->image_transport,
-            "image_transport plugin: raw, compressed (decoded here if the "
-            "plugin is missing), theora, ...")
-      .Note("a plugin name, no '/' or ' '");
-  registry->Add(key("camera_info_latest"), &o->camera_info_latest,
-                "false: camera_info paired by exact stamp (CameraSubscriber); "
-                "true: the latest one");
-  registry->Add(key("rectified"), &o->rectified,
-                "images are rectified: camera from P, D ignored (also on for "
-                "an image_rect topic)");
-  registry
-      ->Add(key("depth_encoding"), &o->depth_encoding,
-            "~depth/image_rect: 32FC1 metres, NaN unknown (REP 118); 16UC1 "
-            "millimetres, 0 unknown")
-      .OneOf({"32FC1", "16UC1"});
-  registry
-      ->Add(key("sparse_source"), &o->sparse_source,
-            "tracker (online SIFT tracks), topic (`sparse_points`), none")
-      .OneOf({"tracker", "topic", "none"});
-  registry
-      ->Add(key("input_queue_size"), &o->input_queue_size,
-            "frames waiting for the front end; the oldest is dropped "
-            "(counted) beyond it")
-      .Min(1)
-      .Max(1000);
+        .OneOf({"tf", "topic", "pose", "pose_with_covariance", "transform",
+                "odometry"});
+    registry->Add(key("pose_frame"), &o->pose_frame,
+                  "frame the topic poses are of; \"\" = the camera (pose), the "
+                  "child_frame_id (transform, odometry); a body frame needs "
+                  "camera_extrinsic or tf body <- camera");
+    registry
+        ->Add(key("camera_extrinsic"), &o->camera_extrinsic,
+              "T_body_camera \"x y z qx qy qz qw\"; \"\" = from tf "
+              "(/tf_static)")
+        .Note("\"\" or 7 numbers");
+    registry
+        ->Add(key("tf_timeout"), &o->tf_timeout,
+              "s to wait for the pose of a frame")
+        .Min(0)
+        .Max(60);
+    registry->Add(key("camera_frame"), &o->camera_frame,
+                  "camera optical frame; \"\" = the image header's frame_id");
+    registry
+        ->Add(key("image_transport"), &o->image_transport,
+              "image_transport plugin: raw, compressed (decoded here if the "
+              "plugin is missing), theora, ...")
+        .Note("a plugin name, no '/' or ' '");
+    registry->Add(
+        key("camera_info_latest"), &o->camera_info_latest,
+        "false: camera_info paired by exact stamp (CameraSubscriber); "
+        "true: the latest one");
+    registry->Add(key("rectified"), &o->rectified,
+                  "images are rectified: camera from P, D ignored (also on for "
+                  "an image_rect topic)");
+    registry
+        ->Add(key("sparse_source"), &o->sparse_source,
+              "tracker (online SIFT tracks), topic (`sparse_points`), none")
+        .OneOf({"tracker", "topic", "none"});
+    registry
+        ->Add(key("input_queue_size"), &o->input_queue_size,
+              "frames waiting for the front end; the oldest is dropped "
+              "(counted) beyond it")
+        .Min(1)
+        .Max(1000);
+  }
+  if (Reconstructs(o->role)) {
+    registry
+        ->Add(key("depth_encoding"), &o->depth_encoding,
+              "~depth/image_rect: 32FC1 metres, NaN unknown (REP 118); 16UC1 "
+              "millimetres, 0 unknown")
+        .OneOf({"32FC1", "16UC1"});
+  }
   registry
       ->Add(key("diagnostics_period"), &o->diagnostics_period,
             "s between diagnostics")
       .Above(0);
-  registry
-      ->Add(key("role"), &o->role,
-            "standalone (select and reconstruct), selector (select, publish "
-            "~keyframes for workers), worker (keyframes from `keyframes`)")
-      .OneOf({"standalone", "selector", "worker"});
+  // The stream's keys follow the role too.
+  o->stream.select_keyframes = ReadsCamera(o->role);
+  o->stream.reconstruct = Reconstructs(o->role);
   RegisterOptions(registry, prefix, &o->stream);
   // The node keeps its keyframes at mvs/max_image_size (its Check()).
   registry->Find(OptionRegistry::Join(prefix, "mvs.max_image_size"))
@@ -328,16 +354,15 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   RegisterOptions(registry, key("fusion"), &o->session.fusion);
 }
 
-DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params) {
+DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params,
+                                      DepthRole role) {
   DepthNodeOptions o;
+  o.role = role;
   OptionRegistry registry;
   RegisterOptions(&registry, "", &o);
   ReadParams(params, &registry);
-  // A worker's sparse points come with its keyframes; a selector
-  // reconstructs nothing.
-  o.stream.use_tracker = o.sparse_source == "tracker" && o.role != "worker";
-  o.stream.select_keyframes = o.role != "worker";
-  o.stream.reconstruct = o.role != "selector";
+  // A worker's sparse points come with its keyframes.
+  o.stream.use_tracker = o.sparse_source == "tracker" && ReadsCamera(role);
   o.stream.max_image_size = o.stream.mvs.max_image_size;
   CheckOptions(o, params);
   return o;
@@ -352,8 +377,10 @@ FusionNodeOptions ReadFusionNodeOptions(const ParamSource& params) {
   return o;
 }
 
-std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params) {
+std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params,
+                                                DepthRole role) {
   DepthNodeOptions o;
+  o.role = role;
   OptionRegistry registry;
   RegisterOptions(&registry, "", &o);
   return UnknownParams(params, registry);

@@ -4,6 +4,8 @@
 #include <ros/console.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <algorithm>
+
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/ros/conversions.h"
 
@@ -43,12 +45,22 @@ std::vector<std::string> RosParamSource::Names() const {
   return out;
 }
 
-DepthNodeOptions LoadDepthNodeOptions(const ros::NodeHandle& pnh) {
+DepthNodeOptions LoadDepthNodeOptions(const ros::NodeHandle& pnh,
+                                      DepthRole role) {
   RosParamSource params(pnh);
-  DepthNodeOptions o = ReadDepthNodeOptions(params);
-  for (const std::string& n : UnknownDepthNodeParams(params))
-    ROS_WARN("%s: unknown parameter '%s' (ignored; see config/depth_node.yaml)",
-             pnh.getNamespace().c_str(), n.c_str());
+  DepthNodeOptions o = ReadDepthNodeOptions(params, role);
+  // A key of another depth role (one YAML for a selector and its workers)
+  // is only noted; a key of none is a typo.
+  const std::vector<std::string> typos =
+      UnknownDepthNodeParams(params, DepthRole::kStandalone);
+  for (const std::string& n : UnknownDepthNodeParams(params, role)) {
+    if (std::count(typos.begin(), typos.end(), n))
+      ROS_WARN("%s: unknown parameter '%s' (ignored; see config/%s)",
+               pnh.getNamespace().c_str(), n.c_str(), ConfigFileName(role));
+    else
+      ROS_INFO("%s: parameter '%s' is not read by a %s (ignored)",
+               pnh.getNamespace().c_str(), n.c_str(), RoleName(role));
+  }
   return o;
 }
 

@@ -70,7 +70,7 @@ StreamReconstructor::StreamReconstructor(const StreamOptions& options,
   if (options_.use_tracker)
     tracker_ = std::make_unique<SparseTracker>(options_.tracker, nullptr);
   dispatcher_ = std::make_unique<ThreadPool>(1);
-  if (options_.num_threads > 1)
+  if (options_.reconstruct && options_.num_threads > 1)
     inner_pool_ = std::make_unique<ThreadPool>(options_.num_threads - 1);
   last_keyframe_wall_ = WallSeconds();
 }
@@ -834,43 +834,48 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   auto key = [&prefix](const char* name) {
     return OptionRegistry::Join(prefix, name);
   };
-  registry
-      ->Add(key("max_pose_jump"), &o->max_pose_jump,
-            "m between frames < 1 s apart that count as a pose reset, 0 = off")
-      .Min(0);
-  RegisterOptions(registry, prefix, &o->keyframes);
+  if (o->select_keyframes) {
+    registry
+        ->Add(key("max_pose_jump"), &o->max_pose_jump,
+              "m between frames < 1 s apart that count as a pose reset, 0 = no "
+              "limit (never a reset)")
+        .Min(0);
+    RegisterOptions(registry, prefix, &o->keyframes);
+  }
   RegisterOptions(registry, prefix, &o->store);
-  registry
-      ->Add(key("num_threads"), &o->num_threads,
-            "threads inside one reconstruction")
-      .Min(1);
-  registry
-      ->Add(key("max_pending"), &o->max_pending,
-            "reconstructions queued or running")
-      .Min(1);
-  registry
-      ->Add(key("min_neighbors"), &o->min_neighbors,
-            "good neighbours (global view selection) before reconstructing")
-      .Min(1);
-  registry
-      ->Add(key("lookahead"), &o->lookahead,
-            "a revision waits until the keyframes up to this many after "
-            "it have this many later keyframes (or idle_flush s without one)")
-      .Min(0);
-  registry
-      ->Add(key("idle_flush"), &o->idle_flush,
-            "s without a new keyframe after which waiting keyframes are "
-            "matched and revised")
-      .Min(0);
-  registry
-      ->Add(key("worker_index"), &o->worker_index,
-            "several workers: this one reconstructs the keyframes whose "
-            "stamp hashes to it (KeyframeOwner)")
-      .Min(0)
-      .Note("< worker_count");
-  registry
-      ->Add(key("worker_count"), &o->worker_count, "number of depth workers")
-      .Min(1);
+  if (o->reconstruct) {
+    registry
+        ->Add(key("num_threads"), &o->num_threads,
+              "threads inside one reconstruction")
+        .Min(1);
+    registry
+        ->Add(key("max_pending"), &o->max_pending,
+              "reconstructions queued or running")
+        .Min(1);
+    registry
+        ->Add(key("min_neighbors"), &o->min_neighbors,
+              "good neighbours (global view selection) before reconstructing")
+        .Min(1);
+    registry
+        ->Add(key("lookahead"), &o->lookahead,
+              "a revision waits until the keyframes up to this many after "
+              "it have this many later keyframes (or idle_flush s without one)")
+        .Min(0);
+    registry
+        ->Add(key("idle_flush"), &o->idle_flush,
+              "s without a new keyframe after which waiting keyframes are "
+              "matched and revised")
+        .Min(0);
+    registry
+        ->Add(key("worker_index"), &o->worker_index,
+              "several workers: this one reconstructs the keyframes whose "
+              "stamp hashes to it (KeyframeOwner)")
+        .Min(0)
+        .Note("< worker_count");
+    registry
+        ->Add(key("worker_count"), &o->worker_count, "number of depth workers")
+        .Min(1);
+  }
   // use_tracker follows the node's sparse_source. Of the core's options
   // (the CLI's mvs.*, consistency.* and tracker.* keys) only those of
   // kStreamCoreKeys are offered; the others keep the library defaults.
@@ -879,7 +884,13 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   // The revisions' consistency step: the CLI's consistency.* keys.
   RegisterOptions(&core, key("consistency"), &o->mvs.consistency);
   RegisterOptions(&core, key("tracker"), &o->tracker);
-  for (const char* k : kStreamCoreKeys) registry->Add(*core.Find(key(k)));
+  for (const char* k : kStreamCoreKeys) {
+    const std::string name = k;
+    const bool tracker = name.compare(0, 8, "tracker.") == 0;
+    const bool size = name == "mvs.max_image_size";
+    if (size || (tracker ? o->select_keyframes : o->reconstruct))
+      registry->Add(*core.Find(key(k)));
+  }
 }
 
 }  // namespace wild_mvs

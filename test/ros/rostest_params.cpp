@@ -76,13 +76,14 @@ TEST(Params, ReconstructYamlLoadsIntoTheNodes) {
   EXPECT_DOUBLE_EQ(drop, 0.5);
   const RosParamSource params(pnh);
 
-  DepthNodeOptions d = ReadDepthNodeOptions(params);
+  DepthNodeOptions d = ReadDepthNodeOptions(params, DepthRole::kStandalone);
   DepthNodeOptions defaults;
   OptionRegistry depth, library, library_defaults;
   RegisterOptions(&depth, "", &d);
   RegisterCoreOptions(&d, &library);
   RegisterCoreOptions(&defaults, &library_defaults);
-  const std::vector<std::string> unknown = UnknownDepthNodeParams(params);
+  const std::vector<std::string> unknown =
+      UnknownDepthNodeParams(params, DepthRole::kStandalone);
   for (const char* section : {"mvs", "consistency", "tracker"})
     ExpectSameValues(cli, depth, section, 1, &library, &library_defaults,
                      &params, unknown);

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# config/reconstruct.yaml, depth_node.yaml and fusion_node.yaml are exactly
+# config/reconstruct.yaml, the depth roles' depth_node.yaml,
+# keyframe_selector.yaml and depth_worker.yaml, and fusion_node.yaml are exactly
 # what wild_mvs_write_config writes from the option registry (every key, its
 # default and its valid range). After changing an option:
 #   build/devel/lib/wild_mvs/wild_mvs_write_config config   (or devel/lib/...)
@@ -10,7 +11,13 @@ TMP="$(mktemp -d)"
 trap 'rm -rf "$TMP"' EXIT
 "$TOOL" "$TMP" >/dev/null
 status=0
-for f in reconstruct.yaml depth_node.yaml fusion_node.yaml; do
+# Every file the tool writes is in config/, and the other way round.
+for f in "$TMP"/*.yaml; do
+  f=$(basename "$f")
+  [ -f "$CONFIG/$f" ] || { echo "FAIL: $CONFIG/$f missing"; status=1; }
+done
+for f in reconstruct.yaml depth_node.yaml keyframe_selector.yaml \
+  depth_worker.yaml fusion_node.yaml; do
   if ! diff -u "$CONFIG/$f" "$TMP/$f"; then
     echo "FAIL: $CONFIG/$f is not what wild_mvs_write_config writes" \
          "(regenerate: wild_mvs_write_config $CONFIG)"

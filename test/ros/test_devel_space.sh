@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The devel space works with the standard ROS tools from any directory:
-# rosrun finds depth_node, fusion_node and finish_when_idle.py (rosrun skips
+# rosrun finds the node executables and finish_when_idle.py (rosrun skips
 # <package>/build/, hence the devel space outside build/ for <source>/build),
 # and the nodelets load standalone and into a manager.
 #   test/ros/test_devel_space.sh BUILD_DIR DEVEL_DIR
@@ -14,7 +14,8 @@ source "$DEVEL/setup.bash"
 source "$HERE/ros_space_lib.sh"
 cd "$TMP"   # not the source or build folder
 
-for exe in depth_node fusion_node finish_when_idle.py; do
+for exe in depth_node keyframe_selector_node depth_worker_node fusion_node \
+  finish_when_idle.py; do
   # exactly one candidate (rosrun asks to pick one otherwise), in DEVEL
   rosrun --prefix 'echo' wild_mvs "$exe" >"$TMP/which.log" 2>&1 </dev/null ||
     fail "rosrun wild_mvs $exe: $(cat "$TMP/which.log")"
@@ -64,6 +65,22 @@ rosrun nodelet nodelet load wild_mvs/DepthNodelet manager __name:=loaded_depth \
 ld=$!; PIDS+=($ld)
 wait_for_topic /loaded_depth/depth_view || fail "nodelet load wild_mvs/DepthNodelet manager"
 wait_for_topic /loaded_fusion/cloud || fail "nodelet load wild_mvs/FusionNodelet manager"
+# The selector and the worker nodelets: a selector publishes keyframes and
+# no depth, a worker depth views.
+rosrun nodelet nodelet load wild_mvs/KeyframeSelectorNodelet manager \
+  __name:=loaded_selector >"$TMP/load_selector.log" 2>&1 &
+lsel=$!; PIDS+=($lsel)
+rosrun nodelet nodelet load wild_mvs/DepthWorkerNodelet manager \
+  __name:=loaded_worker >"$TMP/load_worker.log" 2>&1 &
+lw=$!; PIDS+=($lw)
+wait_for_topic /loaded_selector/keyframes ||
+  fail "nodelet load wild_mvs/KeyframeSelectorNodelet manager"
+wait_for_topic /loaded_worker/depth_view ||
+  fail "nodelet load wild_mvs/DepthWorkerNodelet manager"
+! rostopic list | grep -qx /loaded_selector/depth_view ||
+  fail "the keyframe selector advertises depth_view"
+stop "$lw" "nodelet load (worker)"
+stop "$lsel" "nodelet load (selector)"
 stop "$ld" "nodelet load (depth)"
 stop "$lf" "nodelet load (fusion)"
 stop "$mgr" "nodelet manager"

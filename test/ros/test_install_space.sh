@@ -13,6 +13,9 @@ cmake --install "$BUILD" --prefix "$PREFIX" >"$PREFIX.install.log" 2>&1 ||
   { tail -30 "$PREFIX.install.log" >&2; rm -f "$PREFIX.install.log"; echo "FAIL: cmake --install" >&2; exit 1; }
 rm -f "$PREFIX.install.log"
 for f in setup.bash lib/wild_mvs/depth_node lib/wild_mvs/fusion_node \
+         lib/wild_mvs/keyframe_selector_node lib/wild_mvs/depth_worker_node \
+         share/wild_mvs/config/keyframe_selector.yaml \
+         share/wild_mvs/config/depth_worker.yaml \
          lib/wild_mvs/wild_mvs_to_bag lib/wild_mvs/finish_when_idle.py \
          lib/libwild_mvs_ros.so bin/wild_mvs share/wild_mvs/package.xml \
          share/wild_mvs/nodelet_plugins.xml share/wild_mvs/launch/reconstruct_bag.launch \

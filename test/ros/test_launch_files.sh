@@ -90,16 +90,22 @@ nodes=$(roslaunch --nodes wild_mvs workers.launch image:=/cam0/image_raw)
 for x in /keyframe_selector /depth_worker_0 /depth_worker_1 /fusion_node; do has "$nodes" "^$x\$" "workers.launch nodes"; done
 args=$(roslaunch --args /keyframe_selector wild_mvs workers.launch image:=/cam0/image_raw)
 has "$args" "camera_info:=/cam0/camera_info" "workers.launch camera_info"
+has "$args" "/keyframe_selector_node " "workers.launch selector executable"
 args=$(roslaunch --args /depth_worker_1 wild_mvs workers.launch)
 has "$args" "keyframes:=/keyframe_selector/keyframes" "workers.launch worker keyframes"
+has "$args" "/depth_worker_node " "workers.launch worker executable"
 has "$args" "get_keyframe:=/keyframe_selector/get_keyframe" "workers.launch worker get_keyframe"
 args=$(roslaunch --args /fusion_node wild_mvs workers.launch)
 has "$args" "keyframe_index:=/keyframe_selector/keyframe_index" "workers.launch fusion keyframe_index"
 params=$(roslaunch --dump-params wild_mvs workers.launch world_frame:=map)
-has "$params" "/keyframe_selector/role: selector" "workers.launch selector role"
-has "$params" "/depth_worker_1/role: worker" "workers.launch worker role"
+# Each role loads its own config file: the selector's has the camera input
+# and no matching, a worker's the matching and no camera input.
+has "$params" "/keyframe_selector/pose_source: tf" "workers.launch selector config"
+hasnt "$params" "/keyframe_selector/mvs/mpgc/" "workers.launch selector config"
+has "$params" "/depth_worker_1/mvs/mpgc/window: 5" "workers.launch worker config"
+hasnt "$params" "/depth_worker_1/pose_source" "workers.launch worker config"
 params=$(roslaunch --dump-params wild_mvs depth_worker.launch index:=2 count:=3 world_frame:=odom)
 has "$params" "/depth_worker_2/worker_count: 3" "depth_worker.launch count"
 has "$params" "/depth_worker_2/world_frame: odom" "depth_worker.launch world_frame"
-has "$params" "/depth_worker_2/role: worker" "depth_worker.launch role"
+hasnt "$params" "/depth_worker_2/image_transport" "depth_worker.launch config"
 echo "PASS: $n launch checks"

@@ -19,7 +19,7 @@ namespace {
 
 TEST(Params, DefaultsAreValid) {
   MapParamSource none;
-  const DepthNodeOptions d = ReadDepthNodeOptions(none);
+  const DepthNodeOptions d = ReadDepthNodeOptions(none, DepthRole::kStandalone);
   EXPECT_EQ(d.world_frame, "world");
   EXPECT_EQ(d.pose_source, "tf");
   EXPECT_TRUE(d.stream.use_tracker);
@@ -44,7 +44,7 @@ TEST(Params, ValuesReachTheCoreOptions) {
                     {"mvs/mpgc/min_active_views", 2},
                     {"mvs/sweep/below_seeds", 7},
                     {"mvs/max_image_size", 320}});
-  const DepthNodeOptions d = ReadDepthNodeOptions(p);
+  const DepthNodeOptions d = ReadDepthNodeOptions(p, DepthRole::kStandalone);
   EXPECT_EQ(d.world_frame, "map");
   EXPECT_DOUBLE_EQ(d.stream.keyframes.min_baseline, 0.2);
   EXPECT_DOUBLE_EQ(d.stream.keyframes.min_angle_deg, 7.0);
@@ -115,14 +115,93 @@ std::string DottedKey(std::string name) {
 
 std::string Dir() { return std::string(WILD_MVS_SOURCE_DIR) + "/config/"; }
 
+// The keys a role registers, by name.
+std::set<std::string> RoleKeys(DepthRole role) {
+  DepthNodeOptions o;
+  o.role = role;
+  OptionRegistry r;
+  RegisterOptions(&r, "", &o);
+  std::set<std::string> keys;
+  for (const auto& opt : r.options()) keys.insert(opt.key());
+  return keys;
+}
+
+// Each role registers only the keys it reads: the selector none of the
+// matching's, the worker none of the camera input's or the keyframe
+// selection's; together they are the standalone node's.
+TEST(Params, RolesRegisterTheKeysTheyRead) {
+  const std::set<std::string> standalone = RoleKeys(DepthRole::kStandalone);
+  const std::set<std::string> selector = RoleKeys(DepthRole::kSelector);
+  const std::set<std::string> worker = RoleKeys(DepthRole::kWorker);
+  for (const char* k : {"pose_source", "image_transport", "rectified",
+                        "sparse_source", "keyframe_min_baseline",
+                        "max_pose_jump", "tracker.features.max_features"}) {
+    EXPECT_TRUE(selector.count(k)) << k;
+    EXPECT_FALSE(worker.count(k)) << k;
+  }
+  for (const char* k :
+       {"depth_encoding", "num_threads", "lookahead", "worker_index",
+        "mvs.mpgc.window", "consistency.min_consistent"}) {
+    EXPECT_FALSE(selector.count(k)) << k;
+    EXPECT_TRUE(worker.count(k)) << k;
+  }
+  for (const char* k : {"world_frame", "diagnostics_period", "max_keyframes",
+                        "mvs.max_image_size"}) {
+    EXPECT_TRUE(selector.count(k)) << k;
+    EXPECT_TRUE(worker.count(k)) << k;
+  }
+  std::set<std::string> both = selector;
+  both.insert(worker.begin(), worker.end());
+  EXPECT_EQ(both, standalone);
+  // A key of another role is unknown (warned about) and not read.
+  const MapParamSource p(
+      {{"pose_source", std::string("odometry")}, {"mvs/mpgc/window", 7}});
+  EXPECT_EQ(UnknownDepthNodeParams(p, DepthRole::kWorker),
+            std::vector<std::string>{"pose_source"});
+  EXPECT_EQ(ReadDepthNodeOptions(p, DepthRole::kWorker).pose_source, "tf");
+  EXPECT_EQ(UnknownDepthNodeParams(p, DepthRole::kSelector),
+            std::vector<std::string>{"mvs/mpgc/window"});
+  EXPECT_EQ(
+      ReadDepthNodeOptions(p, DepthRole::kSelector).stream.mvs.mpgc.window,
+      MpgcOptions().window);
+  // The role sets the stream's part and whether it tracks.
+  const DepthNodeOptions sel =
+      ReadDepthNodeOptions(MapParamSource(), DepthRole::kSelector);
+  EXPECT_TRUE(sel.stream.select_keyframes);
+  EXPECT_FALSE(sel.stream.reconstruct);
+  EXPECT_TRUE(sel.stream.use_tracker);
+  const DepthNodeOptions wrk =
+      ReadDepthNodeOptions(MapParamSource(), DepthRole::kWorker);
+  EXPECT_FALSE(wrk.stream.select_keyframes);
+  EXPECT_TRUE(wrk.stream.reconstruct);
+  EXPECT_FALSE(wrk.stream.use_tracker);
+  EXPECT_STREQ(RoleName(DepthRole::kWorker), "worker");
+}
+
+// Each role's config file (generated: test/ros/test_config_files.sh) loads
+// without an unknown key and lists every key of the role.
+TEST(Params, RoleConfigFilesListTheRolesKeys) {
+  for (DepthRole role :
+       {DepthRole::kStandalone, DepthRole::kSelector, DepthRole::kWorker}) {
+    const MapParamSource file =
+        ParamsFromYaml(YAML::LoadFile(Dir() + ConfigFileName(role)));
+    EXPECT_TRUE(UnknownDepthNodeParams(file, role).empty()) << RoleName(role);
+    ReadDepthNodeOptions(file, role);  // valid
+    std::set<std::string> names;
+    for (const std::string& n : file.Names()) names.insert(DottedKey(n));
+    EXPECT_EQ(names, RoleKeys(role)) << RoleName(role);
+  }
+}
+
 // The config files list every parameter with its default (they are
 // generated: test/ros/test_config_files.sh); loaded as rosparam would, every
 // key is known and the values read back to the defaults.
 TEST(Params, ConfigFilesLoadAsTheDefaults) {
   const MapParamSource depth =
       ParamsFromYaml(YAML::LoadFile(Dir() + "depth_node.yaml"));
-  EXPECT_TRUE(UnknownDepthNodeParams(depth).empty());
-  const DepthNodeOptions d = ReadDepthNodeOptions(depth);
+  EXPECT_TRUE(UnknownDepthNodeParams(depth, DepthRole::kStandalone).empty());
+  const DepthNodeOptions d =
+      ReadDepthNodeOptions(depth, DepthRole::kStandalone);
   EXPECT_EQ(d.stream.mvs.mpgc.window, MpgcOptions().window);
   const MapParamSource fusion =
       ParamsFromYaml(YAML::LoadFile(Dir() + "fusion_node.yaml"));
@@ -184,7 +263,8 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
     only[section] = all[section];
     const MapParamSource params = ParamsFromYaml(only);
     std::set<std::string> unknown;
-    for (const std::string& n : UnknownDepthNodeParams(params))
+    for (const std::string& n :
+         UnknownDepthNodeParams(params, DepthRole::kStandalone))
       unknown.insert(n);
     int known = 0;
     for (const std::string& n : params.Names()) {
@@ -219,13 +299,15 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
   LoadOptionsYamlString(&cli, tuned, "tuned");
   // ... and the depth node's (rosparam load into its namespace).
   const MapParamSource params = ParamsFromYaml(YAML::Load(tuned));
-  const DepthNodeOptions d = ReadDepthNodeOptions(params);
+  const DepthNodeOptions d =
+      ReadDepthNodeOptions(params, DepthRole::kStandalone);
   DepthNodeOptions node = d;
   OptionRegistry r, core, library;
   RegisterOptions(&r, "", &node);
   RegisterCoreOptions(&node, &core);
   RegisterCoreOptions(&defaults, &library);
-  const std::vector<std::string> unknown = UnknownDepthNodeParams(params);
+  const std::vector<std::string> unknown =
+      UnknownDepthNodeParams(params, DepthRole::kStandalone);
   for (const auto& o : cli.options()) {
     if (r.Has(o.key())) {
       EXPECT_EQ(r.Find(o.key())->Text(), o.Text()) << o.key();
@@ -267,7 +349,7 @@ TEST(Params, RangesAgreeWithCheck) {
 
 std::string ErrorOf(const MapParamSource& p) {
   try {
-    ReadDepthNodeOptions(p);
+    ReadDepthNodeOptions(p, DepthRole::kStandalone);
   } catch (const Error& e) {
     return e.what();
   }
@@ -316,7 +398,7 @@ TEST(Params, BadValuesNameTheParameter) {
 TEST(Params, UnknownParametersAreListed) {
   MapParamSource p(
       {{"keyframe_min_angel", 5.0}, {"world_frame", std::string("w")}});
-  const auto unknown = UnknownDepthNodeParams(p);
+  const auto unknown = UnknownDepthNodeParams(p, DepthRole::kStandalone);
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_EQ(unknown[0], "keyframe_min_angel");
   // The keys before the registry (renamed: docs/ROS.md) are unknown now.
@@ -326,14 +408,16 @@ TEST(Params, UnknownParametersAreListed) {
                                              {"mvs/local_view_selection", true},
                                              {"mvs/sweep_step", 8},
                                              {"tracker/feature_downscale", 1.0},
-                                             {"mvs/mpgc/window", 5}}))
+                                             {"mvs/mpgc/window", 5}}),
+                             DepthRole::kStandalone)
           .size(),
       5u);
   // Fixed in the node now (named constants) or one key for both sizes.
   EXPECT_EQ(UnknownDepthNodeParams(MapParamSource({{"error_throttle", 5.0},
                                                    {"drop_window", 60.0},
                                                    {"repair_delay", 1.0},
-                                                   {"max_image_size", 320}}))
+                                                   {"max_image_size", 320}}),
+                                   DepthRole::kStandalone)
                 .size(),
             4u);
   // Core options the node leaves at the library default.
@@ -341,7 +425,8 @@ TEST(Params, UnknownParametersAreListed) {
                 MapParamSource({{"mvs/mpgc/explain_margin", 0.1},
                                 {"mvs/mpgc/window_step", 1},
                                 {"tracker/scene_depth", 3.0},
-                                {"consistency/free_space_margin", 0.02}}))
+                                {"consistency/free_space_margin", 0.02}}),
+                DepthRole::kStandalone)
                 .size(),
             4u);
   EXPECT_TRUE(

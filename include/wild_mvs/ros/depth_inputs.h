@@ -43,12 +43,15 @@
 namespace wild_mvs {
 namespace ros1 {
 
-// A received image (raw or compressed), before conversion; for a worker
-// (~role worker) a keyframe message or a keyframe index instead.
+// A received image (raw or compressed), before conversion; for a depth
+// worker a keyframe message or a keyframe index instead.
 struct DepthFrame {
   sensor_msgs::ImageConstPtr raw;
   sensor_msgs::CompressedImageConstPtr compressed;
   sensor_msgs::CameraInfoConstPtr info;  // set by PairCameraInfo
+  // The image is rectified: the camera is P's, D is ignored (~rectified or
+  // an image_rect topic; a worker: the selector's SelectedKeyframe).
+  bool rectified = false;
   ros::Time stamp;
   std::string frame_id;
   wild_mvs::SelectedKeyframeConstPtr keyframe;
@@ -127,8 +130,8 @@ class DepthInputs {
   DropFn drop_;
   FrameFn on_frame_;
   PointsFn on_points_;
-  std::string image_topic_, info_topic_;      // resolved input names
-  bool rectified_ = false;                    // camera from P, D ignored
+  std::string image_topic_, info_topic_;  // resolved input names
+  bool rectified_ = false;                // the images' DepthFrame::rectified
   std::unique_ptr<Undistorter> undistorter_;  // front end only
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "wild_mvs/ros/diagnostics.h"
+#include "wild_mvs/ros/params.h"
 #include "wild_mvs/stream/drop_counter.h"
 #include "wild_mvs/stream/stream_reconstructor.h"
 
@@ -59,10 +60,10 @@ struct DepthInputStats {
   size_t queued = 0;              // input queue length
   int queue_size = 0;             // its bound
   uint64_t recent_evictions = 0;  // within the drop counter's window
-  // Several workers (~role): "standalone", "selector" or "worker"; the
-  // selector's keyframes published and served on ~get_keyframe, a worker's
-  // keyframes received, fetched and lost (KeyframeReceiver::Stats).
-  std::string role = "standalone";
+  // The node's role (params.h); the selector's keyframes published and
+  // served on ~get_keyframe, a worker's keyframes received, fetched and
+  // lost (KeyframeReceiver::Stats).
+  DepthRole role = DepthRole::kStandalone;
   uint64_t keyframes_published = 0, keyframes_served = 0;
   uint64_t keyframes_received = 0, keyframes_fetched = 0;
   uint64_t keyframes_lost = 0, keyframes_repeated = 0;

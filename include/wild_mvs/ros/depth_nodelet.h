@@ -1,5 +1,11 @@
 // Copyright wild_mvs authors. The depth node: calibrated, posed images in,
 // per-keyframe depth / confidence / normals / points and DepthView out.
+// One class for the three roles (DepthRole, params.h), each a nodelet and
+// an executable of its own: wild_mvs/DepthNodelet (depth_node) selects and
+// reconstructs; wild_mvs/KeyframeSelectorNodelet (keyframe_selector_node)
+// selects and publishes ~keyframes; wild_mvs/DepthWorkerNodelet
+// (depth_worker_node) reconstructs its share of a selector's `keyframes`
+// (below, "in" is the camera input of the first two).
 //
 // Topics (relative, meant for remapping):
 //   in:  image (through image_transport: ~image_transport names the plugin;
@@ -25,7 +31,8 @@
 // image's frame_id) at the image stamp, waiting up to ~tf_timeout of wall
 // time (never ROS time: /clock may stand still). Leading '/' of incoming
 // frame ids is stripped (one warning per id). Periodic work runs on steady
-// timers. Parameters: config/depth_node.yaml.
+// timers. Parameters: config/depth_node.yaml, keyframe_selector.yaml,
+// depth_worker.yaml (each role registers only the keys it reads).
 //
 // Callbacks only queue messages (bounded; the oldest is dropped and counted
 // when full). A front-end thread looks up the pose, lets the
@@ -40,13 +47,16 @@
 
 #include <memory>
 
+#include "wild_mvs/ros/params.h"
+
 namespace wild_mvs {
 namespace ros1 {
 
 class DepthNode {
  public:
   // Throws wild_mvs::Error on bad parameters.
-  DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh);
+  DepthNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
+            DepthRole role);
   ~DepthNode();
 
  private:

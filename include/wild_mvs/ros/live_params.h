@@ -58,8 +58,9 @@ class LiveParams {
 // The depth node's live parameters: the keyframe thresholds and the main
 // MVS thresholds (keyframe_min_baseline, keyframe_min_angle_deg,
 // mvs/max_image_size, mvs/global/num_neighbors, mvs/local/min_ncc,
-// mvs/mpgc/drop_ncc, mvs/growing/revisit_margin) over a copy of the node's
-// options; a change DepthNodeOptions::Check() accepts goes to `apply`.
+// mvs/mpgc/drop_ncc, mvs/growing/revisit_margin; those its role registers)
+// over a copy of the node's options; a change DepthNodeOptions::Check()
+// accepts goes to `apply`.
 class DepthLiveParams {
  public:
   DepthLiveParams(const ros::NodeHandle& private_nh,

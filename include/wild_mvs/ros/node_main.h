@@ -18,18 +18,18 @@ namespace ros1 {
 
 inline void RequestShutdownOnSignal(int) { ros::requestShutdown(); }
 
-// Runs node type T (constructed from the public and private node handles)
-// until SIGINT or SIGTERM, then destroys it (so its destructor runs: the
-// fusion node saves there). Returns the process exit code.
-template <typename T>
-int RunNode(int argc, char** argv, const char* name) {
+// Runs node type T (constructed from the public and private node handles,
+// then `args`) until SIGINT or SIGTERM, then destroys it (so its destructor
+// runs: the fusion node saves there). Returns the process exit code.
+template <typename T, typename... Args>
+int RunNode(int argc, char** argv, const char* name, Args... args) {
   ros::init(argc, argv, name, ros::init_options::NoSigintHandler);
   std::signal(SIGINT, RequestShutdownOnSignal);
   std::signal(SIGTERM, RequestShutdownOnSignal);
   ros::NodeHandle nh, pnh("~");
   std::unique_ptr<T> node;
   try {
-    node = std::make_unique<T>(nh, pnh);
+    node = std::make_unique<T>(nh, pnh, args...);
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", pnh.getNamespace().c_str(), e.what());
     return 1;

@@ -96,6 +96,31 @@ constexpr double kErrorThrottle = 5.0;
 constexpr double kDropWindow = 60.0;
 constexpr double kRepairDelay = 1.0;
 
+// The parts a depth node plays; each is a nodelet (and a node executable)
+// of its own:
+//   kStandalone (wild_mvs/DepthNodelet, depth_node): selects keyframes from
+//   `image` and reconstructs the ones it owns (KeyframeOwner of
+//   worker_index / worker_count; all of them with the default count 1);
+//   kSelector (wild_mvs/KeyframeSelectorNodelet, keyframe_selector_node):
+//   selects keyframes from `image` and tracks them, then publishes each
+//   keyframe with its pose and the sparse tracks on ~keyframes (and
+//   ~keyframe_index, ~get_keyframe); reconstructs none;
+//   kWorker (wild_mvs/DepthWorkerNodelet, depth_worker_node): takes every
+//   keyframe from a selector's `keyframes` topic and reconstructs the ones
+//   it owns. A gap in the keyframe ids, or a keyframe `keyframe_index`
+//   announced that has not arrived after kRepairDelay, is fetched from the
+//   selector's `get_keyframe`.
+enum class DepthRole { kStandalone, kSelector, kWorker };
+// "standalone", "selector", "worker" (diagnostics, messages).
+const char* RoleName(DepthRole role);
+// The file in config/ that lists the role's parameters with their
+// defaults: depth_node.yaml, keyframe_selector.yaml, depth_worker.yaml.
+const char* ConfigFileName(DepthRole role);
+// The camera input (image, camera_info, pose, sparse points): standalone
+// and selector. Reconstruction (depth maps out): standalone and worker.
+inline bool ReadsCamera(DepthRole r) { return r != DepthRole::kWorker; }
+inline bool Reconstructs(DepthRole r) { return r != DepthRole::kSelector; }
+
 // Options of the depth node (its ROS-side settings plus the stream
 // reconstructor's and the core's options).
 struct DepthNodeOptions {
@@ -144,20 +169,9 @@ struct DepthNodeOptions {
   int input_queue_size = 5;  // frames waiting for the front end; the oldest
                              // is dropped (counted) beyond it
   double diagnostics_period = 1.0;  // s between diagnostics, > 0
-  // The node's part when depth maps are spread over several workers
-  // (docs/ROS.md, "Several depth workers"):
-  //   "standalone": selects keyframes from `image` and reconstructs the
-  //   ones it owns (KeyframeOwner of worker_index / worker_count; all of
-  //   them with the default worker_count 1);
-  //   "selector": selects keyframes from `image` and tracks them, then
-  //   publishes each keyframe with its pose and the sparse tracks on
-  //   ~keyframes (and ~keyframe_index, ~get_keyframe); reconstructs none;
-  //   "worker": takes every keyframe from a selector's `keyframes` topic
-  //   (`image`, camera_info, pose and sparse_source are not used) and
-  //   reconstructs the ones it owns. A gap in the keyframe ids, or a
-  //   keyframe `keyframe_index` announced that has not arrived after
-  //   kRepairDelay, is fetched from the selector's `get_keyframe`.
-  std::string role = "standalone";
+  // The node's part (docs/ROS.md, "Several depth workers"): set by the
+  // nodelet, not a parameter; it decides which parameters are registered.
+  DepthRole role = DepthRole::kStandalone;
   // Keyframes, store, scheduling, core options. stream.max_image_size is
   // stream.mvs.max_image_size (ReadDepthNodeOptions): one parameter,
   // mvs/max_image_size, sets the size keyframes are kept at and caps the
@@ -213,6 +227,8 @@ struct FusionNodeOptions {
 // sections mvs/, consistency/ and tracker/ with the core keys the node reads
 // (kStreamCoreKeys), FusionNodeOptions::session.fusion is fusion/,
 // with the core's keys (mvs/mpgc/drop_ncc). `prefix` is "" for a node.
+// A depth node registers only the keys its options->role reads (the
+// camera input's with ReadsCamera, the matching's with Reconstructs).
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
                      DepthNodeOptions* options);
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -220,13 +236,18 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
 // (StreamOptions and the keyframe options register beside their structs in
 // src/stream.)
 
-// Reads the options (defaults for unset parameters), checks them, and throws
-// Error naming "<where>/<param>" or the option on a bad value.
-DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params);
+// Reads the options of a node of `role` (defaults for unset parameters),
+// checks them, and throws Error naming "<where>/<param>" or the option on a
+// bad value.
+DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params,
+                                      DepthRole role);
 FusionNodeOptions ReadFusionNodeOptions(const ParamSource& params);
 // Private parameters that the node does not know (typos), e.g.
 // "keyframe_min_angel".
-std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params);
+// A key another role reads is unknown here too (a worker has no
+// pose_source).
+std::vector<std::string> UnknownDepthNodeParams(const ParamSource& params,
+                                                DepthRole role);
 std::vector<std::string> UnknownFusionNodeParams(const ParamSource& params);
 
 }  // namespace ros1

@@ -28,7 +28,8 @@ class RosParamSource : public ParamSource {
 // Error on a bad value); each unknown parameter is warned about
 // (ROS_WARN), naming the config file that lists the known ones. The fusion
 // node's world_frame loses a leading '/' (tf2 frame ids have none; warned).
-DepthNodeOptions LoadDepthNodeOptions(const ros::NodeHandle& private_nh);
+DepthNodeOptions LoadDepthNodeOptions(const ros::NodeHandle& private_nh,
+                                      DepthRole role);
 FusionNodeOptions LoadFusionNodeOptions(const ros::NodeHandle& private_nh);
 
 }  // namespace ros1

@@ -73,7 +73,8 @@ struct StreamOptions {
   int max_pending = 2;   // reconstructions queued or running; more wait
   int worker_index = 0;  // this worker owns the keyframes with
   int worker_count = 1;  // KeyframeOwner(stamp, worker_count) == worker_index
-  // Set by the depth node's ~role (not parameters of their own):
+  // Set by the depth node's role (not parameters of their own; they decide
+  // which of the others are, RegisterOptions):
   bool select_keyframes = true;  // false: every frame is a keyframe
   bool reconstruct = true;       // false: select and track only
   // Good neighbours of a keyframe = the views the core's global view
@@ -95,7 +96,7 @@ struct StreamOptions {
   int max_image_size = 0;
   // A camera jump larger than this (metres) between consecutive frames less
   // than 1 s apart is a pose reset (tracking lost, relocalised): the stream
-  // restarts (store and tracks cleared). 0 = never.
+  // restarts (store and tracks cleared). 0 = no limit (never a reset).
   double max_pose_jump = 0.0;
   bool use_tracker = true;  // false: sparse points come from SetSparsePoints
   MvsOptions mvs;           // the core's per-view MVS options
@@ -104,8 +105,11 @@ struct StreamOptions {
 };
 // Registers the fields under `prefix` (option_registry.h); the depth node
 // uses prefix "" (num_threads, ..., mvs/..., tracker/...). max_image_size
-// and the fields the node's role sets are not registered. Of the core's
-// options (mvs, its consistency, tracker) only kStreamCoreKeys are: the
+// and the fields the node's role sets are not registered, and only the
+// fields the role reads are: keyframe selection, pose jumps and the
+// tracker with select_keyframes; scheduling, workers, matching and
+// consistency with reconstruct; the store and mvs.max_image_size always. Of the
+// core's options (mvs, its consistency, tracker) only kStreamCoreKeys are: the
 // thresholds a robot's user tunes (the CLI's keys of the same name). The
 // others (the wide-window thresholds, the one-view-occluder test, the
 // bilateral weights, the consistency tolerances, the tracker's geometry
