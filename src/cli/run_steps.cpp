@@ -119,11 +119,12 @@ class ProgressObserver : public DepthRunObserver {
     const int valid = map.CountValid();
     const double fill =
         map.empty() ? 0.0 : 100.0 * valid / (map.width() * map.height());
-    std::string note = Msg(
-        prefix, ": ", valid, " samples (", map.width(), "x", map.height(), ", ",
-        static_cast<int>(fill + 0.5), "% filled), ", r.report.seeds_accepted,
-        "/", r.report.seeds_tried, " seeds, ", r.report.planar_samples,
-        " from planes, ", Progress::FormatDuration(r.report.seconds));
+    std::string note =
+        Msg(prefix, ": ", valid, " samples (", map.width(), "x", map.height(),
+            ", ", static_cast<int>(fill + 0.5), "% filled), ",
+            r.report.seeds_accepted, "/", r.report.seeds_tried, " seeds, ",
+            r.report.planar_samples, " from planes, ", r.report.coarse_samples,
+            " from half size, ", Progress::FormatDuration(r.report.seconds));
     for (const std::string& f : r.report.fallbacks) note += "\n    " + f;
     progress_->End(note);
   }

@@ -39,6 +39,7 @@ MvsOptions PaperMvsOptions() {
   o.ablation.photometric_offset = false;
   o.ablation.consistency = false;
   o.ablation.planar_prior = false;
+  o.ablation.coarse_fill = false;
   return o;
 }
 

@@ -68,6 +68,7 @@ std::string ViewReportJson(const ViewReport& r, const Scene& scene) {
      << ",\n  \"seeds_accepted\": " << r.seeds_accepted
      << ",\n  \"samples\": " << r.samples
      << ",\n  \"planar_samples\": " << r.planar_samples
+     << ",\n  \"coarse_samples\": " << r.coarse_samples
      << ",\n  \"pixel_visits\": " << r.pixel_visits << ",\n  \"fallbacks\": [";
   for (size_t i = 0; i < r.fallbacks.size(); ++i)
     os << (i ? ", " : "") << "\"" << JsonEscape(r.fallbacks[i]) << "\"";

@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 
+#include "wild_mvs/core/coarse_fill.h"
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/core/geometric_consistency.h"
 #include "wild_mvs/core/stats.h"
@@ -11,6 +13,13 @@
 namespace wild_mvs {
 
 using Stage = DepthWorkspace::Stage;
+
+// The smallest coarse map (pixels, longest side): a coarse pass runs while
+// half the map's size is at least this (at 640 px: 320 and 160 px).
+constexpr int kMinCoarseSize = 160;
+// Its four samples around a pixel lie on one surface when their planes agree
+// within this (relative depth along the pixel's ray).
+constexpr double kCoarseSpread = 0.01;
 using Step = DepthRunObserver::Step;
 
 DepthController::DepthController(const MvsOptions& options, ThreadPool* pool,
@@ -21,10 +30,58 @@ ViewResult DepthController::Match(const ViewProblem& problem) const {
   Require(problem.scene && problem.images, "a view problem needs a scene",
           " and its images");
   ViewResult r;
-  r.map = ReconstructView(*problem.scene, problem.ref, *problem.images,
-                          options_, pool_, &r.report, problem.mask,
-                          problem.points_per_view, cancel_);
+  r.map = MatchAtScales(problem, options_, &r.report);
   return r;
+}
+
+DepthMap DepthController::MatchAtScales(const ViewProblem& problem,
+                                        const MvsOptions& options,
+                                        ViewReport* report) const {
+  DepthMap map = ReconstructView(*problem.scene, problem.ref, *problem.images,
+                                 options, pool_, report, problem.mask,
+                                 problem.points_per_view, cancel_);
+  const int size = std::max(map.width(), map.height());
+  if (!options.ablation.coarse_fill || size / 2 < kMinCoarseSize) return map;
+  // Where the full-size window cannot match at all, and the half-size one
+  // has texture on its side of any edge.
+  std::shared_ptr<const cv::Mat> image =
+      problem.images->GetResized(problem.ref, map.width(), map.height());
+  CoarseFillMasks masks =
+      PlanCoarseFill(*image, map, options.mpgc.window, options.mpgc.drop_ncc);
+  if (!problem.mask.empty()) {
+    cv::Mat allowed;
+    cv::resize(problem.mask, allowed, masks.fillable.size(), 0, 0,
+               cv::INTER_NEAREST);
+    masks.fillable &= allowed;
+    masks.count = cv::countNonZero(masks.fillable);
+  }
+  if (masks.count == 0) return map;
+  // The half-size map, matched only within reach of a fillable pixel (one
+  // sample plus the window's half width): the fill reads nothing farther.
+  MvsOptions coarse = options;
+  coarse.max_image_size = size / 2;
+  const int reach = 2 * (1 + options.mpgc.window / 2);
+  cv::Mat near;
+  cv::dilate(masks.fillable, near,
+             cv::getStructuringElement(cv::MORPH_RECT,
+                                       cv::Size(2 * reach + 1, 2 * reach + 1)));
+  ViewProblem coarse_problem = problem;
+  const Camera& full = problem.scene->views[problem.ref].camera;
+  cv::resize(near, coarse_problem.mask, cv::Size(full.width, full.height), 0, 0,
+             cv::INTER_NEAREST);
+  if (!problem.mask.empty()) coarse_problem.mask &= problem.mask;
+  ViewReport coarse_report;
+  const DepthMap c = MatchAtScales(coarse_problem, coarse, &coarse_report);
+  cv::Mat usable = masks.usable;
+  if (usable.size() != cv::Size(c.width(), c.height()))
+    cv::resize(masks.usable, usable, cv::Size(c.width(), c.height()), 0, 0,
+               cv::INTER_NEAREST);
+  report->coarse_samples = FillFromCoarse(
+      c, usable, kCoarseSpread, options.mpgc.window / 2, masks.fillable, &map);
+  report->samples += report->coarse_samples;
+  report->pixel_visits += coarse_report.pixel_visits;
+  report->cpu_seconds += coarse_report.cpu_seconds;
+  return map;
 }
 
 ViewResult DepthController::Filter(const DepthMap& raw,

@@ -26,6 +26,11 @@ struct AblationOptions {
   // Bilateral window weights (MpgcOptions::bilateral_*; beyond the paper);
   // false = the plain window.
   bool bilateral_window = true;
+  // Multi-scale: fill the map's empty pixels where the window cannot match
+  // from the view matched at half its working size, itself filled from half
+  // that (coarse_fill.h; beyond the paper); false = one size (paper). Not a
+  // command-line key: `--preset paper` and the tests set it.
+  bool coarse_fill = true;
 };
 
 // Registers the switches under `prefix` (e.g. "ablation").

@@ -62,6 +62,7 @@ struct ViewReport {
   int seeds_tried = 0, seeds_accepted = 0;
   int samples = 0;                     // valid depth samples in the result
   int planar_samples = 0;              // of them, filled by the planar prior
+  int coarse_samples = 0;              // of them, filled by the coarse pass
   long long pixel_visits = 0;          // MPGC runs
   std::vector<std::string> fallbacks;  // "fallback: ..." notes
   double seconds = 0, cpu_seconds = 0;

@@ -124,6 +124,12 @@ class DepthController {
            const std::function<void(const StreamingFusion&)>& done) const;
 
  private:
+  // ReconstructView at the options' size; with the coarse fill, the empty
+  // pixels filled from the map matched at half that size, itself filled the
+  // same way down to kMinCoarseSize.
+  DepthMap MatchAtScales(const ViewProblem& problem, const MvsOptions& options,
+                         ViewReport* report) const;
+
   MvsOptions options_;
   ThreadPool* pool_;
   const std::atomic<bool>* cancel_;
