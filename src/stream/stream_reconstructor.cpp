@@ -656,14 +656,18 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     ++stats_.running;
   }
   // With a revision to follow, the first map is a preview at half the
-  // working size (a quarter of the pixels): out fast, replaced by the
-  // full-size revision.
+  // working size (a quarter of the pixels) without the coarse fill (its
+  // own half-size pass would delay it): out fast, replaced by the
+  // full-size revision, which has it.
   if (mvs.ablation.consistency) {
     const int longest = std::max(kf->image.cols, kf->image.rows);
     const int working = mvs.max_image_size > 0
                             ? std::min(longest, mvs.max_image_size)
                             : longest;
-    if (working / 2 >= kMinPreviewSize) mvs.max_image_size = working / 2;
+    if (working / 2 >= kMinPreviewSize) {
+      mvs.max_image_size = working / 2;
+      mvs.ablation.coarse_fill = false;
+    }
   }
   StreamResult result;
   result.keyframe_id = id;
