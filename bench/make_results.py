@@ -151,6 +151,49 @@ def plot_scale(path, rows):
     plt.close(fig)
 
 
+def mechanism_section(abl_dir, default_rows, setting):
+    """The ablation table: per switch, each family's mean coverage within 1 %
+    and estimates off by more than 5 %, with the default's beside."""
+    def means(rows):
+        return {r["family"]: r for r in rows if r["scene"] == "MEAN"}
+    base = means(default_rows)
+    fams = list(base)
+    md = [f"`bench/run_ablation.sh --size {setting['size']} --seeds {setting['seeds']}`: "
+          "the rendered scene families (images "
+          f"{setting['size']}x{int(setting['size']) * 3 // 4}) with the default options, "
+          "then with one mechanism switched off (`--ablation.NAME false`, "
+          "`core/ablation.h`). Per family: mean coverage within 1 % / estimates off "
+          "by more than 5 %. A mechanism is needed on a family where switching it "
+          "off loses coverage within 1 % or adds estimates off by more than 5 % "
+          "or on the sky; "
+          "one needed on no family is deleted (docs/METHODS.md, \"Benchmark "
+          "protocol\").", ""]
+    header = ["switched off"] + fams + ["needed on"]
+    cell = lambda r: f"{pct(r['cmp@1%'], 1)} / {pct(r['off>5%'])}"
+    body = [["nothing (defaults)"] + [cell(base[f]) for f in fams] + ["-"]]
+    for name in setting["switches"].split():
+        rows = read_tsv(os.path.join(abl_dir, f"no_{name}.tsv"))
+        if not rows:
+            body.append([name] + ["not run"] * len(fams) + ["-"])
+            continue
+        off = means(rows)
+        needed = []
+        for f in fams:
+            if f not in off:
+                continue
+            why = []
+            if num(off[f]["cmp@1%"]) < num(base[f]["cmp@1%"]):
+                why.append("coverage")
+            if (num(off[f]["off>5%"]) > num(base[f]["off>5%"]) or
+                    num(off[f]["sky"]) > num(base[f]["sky"])):
+                why.append("accuracy")
+            if why:
+                needed.append(f"{f} ({', '.join(why)})")
+        body.append([f"`{name}`"] + [cell(off[f]) if f in off else "-" for f in fams] +
+                    ["; ".join(needed) or "**none**"])
+    return md + [table(header, body), ""]
+
+
 def main():
     out, root = sys.argv[1], sys.argv[2]
     meta = {r["key"]: r["value"] for r in read_tsv(os.path.join(out, "meta.tsv"))}
@@ -336,6 +379,17 @@ def main():
     if scenes:
         plot_quality(os.path.join(docs, "results_quality.png"), scenes)
         md += ["![coverage and errors per scene](results_quality.png)", ""]
+
+    # --- mechanisms ------------------------------------------------------------
+    md += ["## Mechanisms: each switched off", ""]
+    abl_dir = os.path.join(out, "ablation")
+    abl_set = read_tsv(os.path.join(abl_dir, "setting.tsv")) if "ablation" not in failed else None
+    abl_def = read_tsv(os.path.join(abl_dir, "default.tsv")) if abl_set is not None else None
+    if abl_def:
+        setting = {r["key"]: r["value"] for r in abl_set}
+        md += mechanism_section(abl_dir, abl_def, setting)
+    else:
+        md += [meta.get("ablation_note") or state("ablation"), ""]
 
     # --- scale ---------------------------------------------------------------
     md += ["## Scale: synthetic photo collections", ""]

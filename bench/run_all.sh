@@ -16,6 +16,8 @@
 #             colmap, else not run;
 #   families  bench/run_families.sh: the rendered scene families with
 #             exact ground truth (relief, weak, courtyard), report seeds;
+#   ablation  bench/run_ablation.sh: the same families at 320x240 with each
+#             mechanism of the method switched off in turn;
 #   scale     bench/run_scale.sh: CPU-s per view and peak RSS against the
 #             number of views (100 / 250 / 500);
 #   live      bench/run_live.sh: the depth and fusion nodes on a bag of a
@@ -34,7 +36,8 @@
 #                collections of 10 / 20 / 40 views at 160 px): minutes
 #                instead of hours; RESULTS.md says so at the top
 #   --skip LIST  comma-separated sections not to run (speed, fountain,
-#                photos, families, scale, live); RESULTS.md lists them as not run
+#                photos, families, ablation, scale, live); RESULTS.md lists
+#                them as not run
 #   --out DIR    raw outputs (default bench/out/all-<UTC time>, ignored by git)
 # Environment: WILD_MVS_DATASETS (default ../shared/datasets of the repo;
 # fountain needs it, temple uses its GT model when present), BUILD_DIR
@@ -57,13 +60,13 @@ while [ $# -gt 0 ]; do
     --threads) THREADS="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --skip-build) BUILD=0; shift ;;
-    -h|--help) sed -n '2,35p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "run_all.sh: unknown option $1 (--help)" >&2; exit 2 ;;
   esac
 done
 for s in ${SKIP//,/ }; do
-  case "$s" in speed | fountain | photos | families | scale | live) ;; *)
-    echo "run_all.sh: --skip takes speed, fountain, photos, families, scale, live; not '$s'" >&2; exit 2 ;;
+  case "$s" in speed | fountain | photos | families | ablation | scale | live) ;; *)
+    echo "run_all.sh: --skip takes speed, fountain, photos, families, ablation, scale, live; not '$s'" >&2; exit 2 ;;
   esac
 done
 skipped() { [[ ",$SKIP," == *",$1,"* ]]; }
@@ -152,6 +155,12 @@ if ! skipped families; then
       cp "$OUT/accuracy/courtyard.tsv" "$OUT/families/courtyard.tsv" || failed families
     FAMILIES_NOTE="\`bench/run_accuracy.sh\`: the courtyard scene (ground, wall, boxes, a pillar, spheres under a sky) in four kinds: constant light; changing light (exposure, white balance, gamma, vignetting, sun direction); clutter (an occluder seen by one view only, every other view); scale (camera distances over a 3.75x range); $VIEWS views at $SCENE_SIZE, whole \`reconstruct\` (depth, filter, fusion, mesh). Coverage within 1 % = ground-truth pixels with an estimate within 1 %; sky = estimates where there is no surface."
   fi
+fi
+if ! skipped ablation; then
+  ABLATION_SEEDS=report
+  [ "$QUICK" = 0 ] || ABLATION_SEEDS=101
+  bash "$ROOT/bench/run_ablation.sh" --skip-build --seeds "$ABLATION_SEEDS" \
+    --threads "$THREADS" --out "$OUT/ablation" || failed ablation
 fi
 SCALE_ARGS="--sizes $SCALE_SIZES --max-image-size $SCALE_PX --threads $THREADS"
 if ! skipped scale; then

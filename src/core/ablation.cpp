@@ -38,6 +38,10 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   registry->Add(key("bilateral_window"), &o->bilateral_window,
                 "weight the matching window bilaterally (mvs.mpgc.bilateral_*)"
                 "; false = the plain window (paper)");
+  registry->Add(key("coarse_fill"), &o->coarse_fill,
+                "multi-scale: fill the empty pixels where the window cannot "
+                "match from the view matched at half the size; false = one "
+                "size (paper)");
 }
 
 }  // namespace wild_mvs

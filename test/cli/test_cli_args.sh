@@ -92,6 +92,18 @@ expect_ok "$WILD_MVS" $R --config "$TMP/rt.yaml" --dump-config
 diff -q "$TMP/rt.yaml" "$TMP/last.log" >/dev/null ||
   fail "dumped config does not round-trip"
 
+# Every part of the method beyond the paper is a switch of the command line
+# (bench/run_ablation.sh turns each off) and --preset paper turns it off.
+for sw in photometric_offset consistency planar_prior explain_test \
+  bilateral_window coarse_fill; do
+  expect_ok "$WILD_MVS" $R --ablation.$sw false --dump-config
+  grep -q "^  $sw: false" "$TMP/last.log" || fail "--ablation.$sw false not applied"
+  expect_ok "$WILD_MVS" $R --dump-config
+  grep -q "^  $sw: true" "$TMP/last.log" || fail "ablation.$sw is not on by default"
+  expect_ok "$WILD_MVS" $R --preset paper --dump-config
+  grep -q "^  $sw: false" "$TMP/last.log" || fail "--preset paper leaves $sw on"
+done
+
 # to-bag without the ROS build: a clear error.
 if [ ! -x "$(dirname "$WILD_MVS")/wild_mvs_to_bag" ]; then
   expect_fail 1 "^wild_mvs to-bag: built without ROS" -- \

@@ -28,8 +28,7 @@ struct AblationOptions {
   bool bilateral_window = true;
   // Multi-scale: fill the map's empty pixels where the window cannot match
   // from the view matched at half its working size, itself filled from half
-  // that (coarse_fill.h; beyond the paper); false = one size (paper). Not a
-  // command-line key: `--preset paper` and the tests set it.
+  // that (coarse_fill.h; beyond the paper); false = one size (paper).
   bool coarse_fill = true;
 };
 

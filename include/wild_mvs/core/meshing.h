@@ -30,8 +30,6 @@ struct MeshingOptions {
   int min_component_faces = 50;
   // Vertex-clustering decimation cell in world units; 0 = off.
   double decimation_cell = 0.0;
-  // Threads of the Poisson solver.
-  int threads = 1;
 
   void Check() const;
 };
