@@ -12,7 +12,8 @@
 #          [--families "relief weak courtyard"] [--switches "a b .."]
 #          [--threads 2] [--out DIR] [--skip-build]
 # Defaults: report seeds, images 320x240 (one switch costs the time of one
-# family run: the whole set takes about 25 min on 2 cores), every switch.
+# family run: the whole set took 65 min on 2 cores shared with another job), every
+# switch.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SEEDS=report
