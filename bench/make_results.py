@@ -383,13 +383,13 @@ def main():
     # --- mechanisms ------------------------------------------------------------
     md += ["## Mechanisms: each switched off", ""]
     abl_dir = os.path.join(out, "ablation")
-    abl_set = read_tsv(os.path.join(abl_dir, "setting.tsv")) if "ablation" not in failed else None
-    abl_def = read_tsv(os.path.join(abl_dir, "default.tsv")) if abl_set is not None else None
-    if abl_def:
+    abl_set = None if "ablation" in failed else read_tsv(os.path.join(abl_dir, "setting.tsv"))
+    abl_def = read_tsv(os.path.join(abl_dir, "default.tsv"))
+    if abl_set and abl_def:
         setting = {r["key"]: r["value"] for r in abl_set}
         md += mechanism_section(abl_dir, abl_def, setting)
     else:
-        md += [meta.get("ablation_note") or state("ablation"), ""]
+        md += [state("ablation"), ""]
 
     # --- scale ---------------------------------------------------------------
     md += ["## Scale: synthetic photo collections", ""]

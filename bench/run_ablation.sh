@@ -19,9 +19,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SEEDS=report
 SIZE=320
 FAMILIES="relief weak courtyard"
-SWITCHES="linearize color rescaling local_view_selection optimize_normal
-optimize_color_scale photometric_offset consistency planar_prior explain_test
-bilateral_window coarse_fill"
+SWITCHES=""  # default: every switch the tool registers under ablation.
 THREADS=2
 OUT="$ROOT/build-bench/ablation"
 BUILD_ARG=()
@@ -47,6 +45,12 @@ run() {
   BUILD_ARG=(--skip-build)
 }
 run --tag default
+if [ -z "$SWITCHES" ]; then
+  SWITCHES=$("${BUILD_DIR:-$ROOT/build-bench}/bin/wild_mvs" reconstruct --dump-config |
+    awk '/^ablation:/ { on = 1; next } /^[^ #]/ { on = 0 }
+         on && /^  [a-z_]+:/ { sub(":", "", $1); print $1 }')
+  [ -n "$SWITCHES" ] || { echo "run_ablation.sh: no ablation switches found" >&2; exit 1; }
+fi
 for s in $SWITCHES; do
   run --tag "no_$s" -- "--ablation.$s" false
 done
