@@ -1,25 +1,58 @@
 #!/usr/bin/env bash
-# Does each mechanism earn its place? (not a test; docs/METHODS.md, "Benchmark
-# protocol"). Runs bench/run_families.sh with the default options and then
-# once per switch of the method (`--ablation.NAME false`, core/ablation.h),
-# on the same rendered scenes, and writes OUT/default.tsv and
-# OUT/no_NAME.tsv (run_families.sh's table). bench/make_results.py shows
-# them side by side: a mechanism whose absence is at least as good on every
-# family, in coverage within 1 % and in estimates off by more than 5 %, is
-# one the policy deletes.
+# Does each mechanism and each threshold earn its place? (not a test;
+# docs/METHODS.md, "Benchmark protocol"). Runs bench/run_families.sh with the
+# default options, then once per switch of the method with that switch off
+# (`--ablation.NAME false`, core/ablation.h), then once per move of a
+# numeric option one step away from its default (`--KEY VALUE`), on the same
+# rendered scenes. Writes OUT/default.tsv, OUT/no_NAME.tsv and
+# OUT/set_KEY_VALUE.tsv (run_families.sh's table). bench/make_results.py
+# shows them side by side: a mechanism whose absence, or a value, that is at
+# least as good on every family, in coverage within 1 % and in estimates off
+# by more than 5 % (for fusion options: the cloud's F-scores), is one the
+# policy deletes or makes the default (after the same result on other
+# seeds). Moves of consistency.* and fusion.* start from the default run's
+# raw depth maps (run_families.sh --from): the matching is the same.
+# A table that already has its family means in OUT is not run again
+# (delete it to redo it).
 #
 # Usage: bench/run_ablation.sh [--seeds report|S1,S2..] [--size 320]
-#          [--families "relief weak courtyard"] [--switches "a b .."]
-#          [--threads 2] [--out DIR] [--skip-build]
-# Defaults: report seeds, images 320x240 (one switch costs the time of one
-# family run: the whole set took 65 min on 2 cores shared with another job), every
-# switch.
+#          [--families "relief weak courtyard"] [--switches "a b ..|none"]
+#          [--moves "KEY=VALUE ..|none"] [--threads 2] [--out DIR]
+#          [--skip-build]
+# Defaults: report seeds, images 320x240, every switch, the moves below.
+# A switch or a move of a matching option costs the time of one family run
+# (about 3 min on 2 idle cores); a move of a filter or fusion option a
+# fifth of it.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SEEDS=report
 SIZE=320
 FAMILIES="relief weak courtyard"
 SWITCHES=""  # default: every switch the tool registers under ablation.
+# One step to each side of the default (one where the default is at the end
+# of the range or the other side is not a value anyone would choose). The
+# wide_* thresholds apply only to images of 1200 px and more (not these).
+MOVES="mvs.local.min_ncc=0.2 mvs.local.min_ncc=0.4
+  mvs.mpgc.drop_ncc=0.3 mvs.mpgc.drop_ncc=0.5
+  mvs.mpgc.min_active_views=2 mvs.mpgc.min_active_views=4
+  mvs.local.num_active=3 mvs.local.num_active=5
+  mvs.global.num_neighbors=6 mvs.global.num_neighbors=14
+  mvs.mpgc.window=3 mvs.mpgc.window=7
+  mvs.mpgc.explain_margin=0.1
+  mvs.mpgc.explain_below_ncc=0.7 mvs.mpgc.explain_below_ncc=0.9
+  mvs.mpgc.bilateral_sigma_color=6 mvs.mpgc.bilateral_sigma_color=24
+  mvs.mpgc.bilateral_sigma_space=3 mvs.mpgc.bilateral_sigma_space=12
+  mvs.mpgc.bilateral_min_weight=0.25 mvs.mpgc.bilateral_min_weight=0.75
+  mvs.growing.revisit_margin=0 mvs.growing.revisit_margin=0.2
+  mvs.sweep.below_seeds=1 mvs.sweep.below_seeds=100
+  consistency.min_consistent=2
+  consistency.max_reprojection_px=0.5 consistency.max_reprojection_px=2
+  consistency.max_relative_depth=0.005 consistency.max_relative_depth=0.02
+  consistency.free_space_margin=0.005 consistency.free_space_margin=0.02
+  fusion.min_support=2 fusion.min_support=4
+  fusion.depth_tolerance=0.005 fusion.depth_tolerance=0.02
+  fusion.reprojection_tolerance_px=1 fusion.reprojection_tolerance_px=4
+  fusion.normal_tolerance_deg=10 fusion.normal_tolerance_deg=40"
 THREADS=2
 OUT="$ROOT/build-bench/ablation"
 BUILD_ARG=()
@@ -29,6 +62,7 @@ while [ $# -gt 0 ]; do
     --size) SIZE="$2"; shift 2 ;;
     --families) FAMILIES="$2"; shift 2 ;;
     --switches) SWITCHES="$2"; shift 2 ;;
+    --moves) MOVES="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --skip-build) BUILD_ARG=(--skip-build); shift ;;
@@ -37,6 +71,9 @@ while [ $# -gt 0 ]; do
   esac
 done
 mkdir -p "$OUT"
+done_already() {  # the table exists with its family means
+  [ -f "$OUT/$1.tsv" ] && grep -q $'\tMEAN\t' "$OUT/$1.tsv"
+}
 run() {
   bash "$ROOT/bench/run_families.sh" ${BUILD_ARG[@]+"${BUILD_ARG[@]}"} \
     --seeds "$SEEDS" --size "$SIZE" --families "$FAMILIES" \
@@ -44,16 +81,27 @@ run() {
   # The binaries exist after the first run.
   BUILD_ARG=(--skip-build)
 }
-run --tag default
+done_already default || run --tag default
 if [ -z "$SWITCHES" ]; then
   SWITCHES=$("${BUILD_DIR:-$ROOT/build-bench}/bin/wild_mvs" reconstruct --dump-config |
     awk '/^ablation:/ { on = 1; next } /^[^ #]/ { on = 0 }
          on && /^  [a-z_]+:/ { sub(":", "", $1); print $1 }')
   [ -n "$SWITCHES" ] || { echo "run_ablation.sh: no ablation switches found" >&2; exit 1; }
 fi
+[ "$SWITCHES" != none ] || SWITCHES=""
+[ "$MOVES" != none ] || MOVES=""
 for s in $SWITCHES; do
-  run --tag "no_$s" -- "--ablation.$s" false
+  done_already "no_$s" || run --tag "no_$s" -- "--ablation.$s" false
 done
-printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\n' "$SIZE" "$SEEDS" \
-  "$(echo $SWITCHES)" >"$OUT/setting.tsv"
+for m in $MOVES; do
+  key=${m%%=*} value=${m#*=}
+  [ "$key" != "$m" ] && [ -n "$value" ] ||
+    { echo "run_ablation.sh: move $m is not KEY=VALUE" >&2; exit 2; }
+  from=()
+  case "$key" in consistency.*|fusion.*) from=(--from default) ;; esac
+  done_already "set_${key}_$value" ||
+    run --tag "set_${key}_$value" ${from[@]+"${from[@]}"} -- "--$key" "$value"
+done
+printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\n' "$SIZE" \
+  "$SEEDS" "$(echo $SWITCHES)" "$(echo $MOVES)" >"$OUT/setting.tsv"
 echo "run_ablation.sh: tables in $OUT" >&2

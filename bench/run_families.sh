@@ -28,13 +28,16 @@
 # Usage: bench/run_families.sh [--seeds tune|report|all|S1,S2..]
 #          [--families "relief weak courtyard"] [--size 640] [--views N]
 #          [--points P] [--noise SIGMA] [--threads 2] [--out DIR] [--tag NAME]
-#          [--skip-build | --build] [-- EXTRA reconstruct ARGS]
+#          [--from TAG] [--skip-build | --build] [-- EXTRA reconstruct ARGS]
 # --size W: images W x 3W/4. --views N: instead of the family's own count
 # (14 relief / weak, 12 courtyard). --noise SIGMA: image noise of the relief
 # and weak families (make_scene --noise; default: the family's, 0.01). The binaries come from
 # BUILD_DIR (default build-bench/): built (wild_mvs, make_scene only) when
 # missing, rebuilt with --build, never with --skip-build. Rendered scenes are
-# kept in OUT/scenes and reused.
+# kept in OUT/scenes and reused. --from TAG: each run starts from the raw
+# depth maps of OUT/TAG (a finished run of the same scenes), so only the
+# consistency filter, fusion and meshing run again: for options of those
+# steps (the cpu_s column then counts only them).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$ROOT/build-bench/families"
@@ -47,6 +50,7 @@ NOISE=""
 THREADS=2
 BUILD=missing
 TAG=""
+FROM=""
 EXTRA=()
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
@@ -60,6 +64,7 @@ while [ $# -gt 0 ]; do
     --threads) THREADS="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --tag) TAG="$2"; shift 2 ;;
+    --from) FROM="$2"; shift 2 ;;
     --skip-build) BUILD=never; shift ;;
     --build) BUILD=always; shift ;;
     -h|--help) usage; exit 0 ;;
@@ -129,6 +134,12 @@ for seed in $SEED_LIST; do
     fi
     run="$OUT/$TAG/${kind}_s$seed"
     rm -rf "$run"
+    if [ -n "$FROM" ]; then
+      [ -d "$OUT/$FROM/${kind}_s$seed/raw" ] ||
+        { echo "run_families.sh: --from $FROM: $OUT/$FROM/${kind}_s$seed/raw missing" >&2; exit 1; }
+      mkdir -p "$run"
+      cp -r "$OUT/$FROM/${kind}_s$seed/raw" "$run/raw"
+    fi
     log="$OUT/$TAG/${kind}_s$seed.log"
     if ! /usr/bin/time -f '%U %S %M' -o "$OUT/$TAG/time.txt" \
       "$BIN/wild_mvs" reconstruct "$scene" "$run" --threads "$THREADS" \
