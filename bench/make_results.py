@@ -194,6 +194,75 @@ def mechanism_section(abl_dir, default_rows, setting):
     return md + [table(header, body), ""]
 
 
+def thresholds_section(abl_dir, default_rows, setting):
+    """The moves table: per numeric option moved one step from its default,
+    each family's means beside the default's, and the families where the
+    moved value is at least as good."""
+    def means(rows):
+        return {r["family"]: r for r in rows if r["scene"] == "MEAN"}
+    base = means(default_rows)
+    fams = list(base)
+    moves = [m.split("=", 1) for m in setting.get("moves", "").split()]
+    md = [f"`bench/run_ablation.sh --size {setting['size']} --seeds {setting['seeds']}`, "
+          "the same scenes: each numeric option of the matching, the filter and the "
+          "fusion moved one step from its default (`--KEY VALUE`), the others at "
+          "theirs. A value at least as good as the default on every family would "
+          "replace it (after the same result on other seeds); one that changes "
+          "nothing anywhere marks an option these scenes do not exercise. The "
+          "`mvs.*.wide_*` thresholds apply only to images of 1200 px and more.", ""]
+    if not moves:
+        return md + ["Not run.", ""]
+
+    def verdict(rows, keys, better_high):
+        moved = means(rows)
+        good, same = [], True
+        for f in fams:
+            if f not in moved:
+                return "-"
+            ok = True
+            for k, high in zip(keys, better_high):
+                a, b = num(moved[f][k]), num(base[f][k])
+                if a != b:
+                    same = False
+                if (a < b) if high else (a > b):
+                    ok = False
+            if ok:
+                good.append(f)
+        if same:
+            return "no change"
+        if len(good) == len(fams):
+            return "**every family**"
+        return ", ".join(good) or "none"
+
+    groups = [("matching and filter: coverage within 1 % / estimates off by more "
+               "than 5 % (a value is at least as good with no less of the first, "
+               "no more of the second and no more on the sky)",
+               lambda k: not k.startswith("fusion."),
+               ["cmp@1%", "off>5%", "sky"], [True, False, False],
+               lambda r: f"{pct(r['cmp@1%'], 1)} / {pct(r['off>5%'])}"),
+              ("fusion: the cloud's F-score at 1 cm / 5 cm",
+               lambda k: k.startswith("fusion."),
+               ["F@1cm", "F@5cm"], [True, True],
+               lambda r: f"{pct(r['F@1cm'], 1)} / {pct(r['F@5cm'], 1)}")]
+    for title, member, keys, high, cell in groups:
+        chosen = [(k, v) for k, v in moves if member(k)]
+        if not chosen:
+            continue
+        md += [f"Options of the {title}:", ""]
+        body = [["defaults"] + [cell(base[f]) for f in fams] + ["-"]]
+        for k, v in chosen:
+            rows = read_tsv(os.path.join(abl_dir, f"set_{k}_{v}.tsv"))
+            if not rows:
+                body.append([f"`{k}` {v}"] + ["not run"] * len(fams) + ["-"])
+                continue
+            moved = means(rows)
+            body.append([f"`{k}` {v}"] +
+                        [cell(moved[f]) if f in moved else "-" for f in fams] +
+                        [verdict(rows, keys, high)])
+        md += [table(["option, value"] + fams + ["at least as good on"], body), ""]
+    return md
+
+
 def main():
     out, root = sys.argv[1], sys.argv[2]
     meta = {r["key"]: r["value"] for r in read_tsv(os.path.join(out, "meta.tsv"))}
@@ -388,6 +457,11 @@ def main():
     if abl_set and abl_def:
         setting = {r["key"]: r["value"] for r in abl_set}
         md += mechanism_section(abl_dir, abl_def, setting)
+    else:
+        md += [state("ablation"), ""]
+    md += ["## Thresholds: each moved one step", ""]
+    if abl_set and abl_def:
+        md += thresholds_section(abl_dir, abl_def, setting)
     else:
         md += [state("ablation"), ""]
 

@@ -71,6 +71,13 @@ while [ $# -gt 0 ]; do
   esac
 done
 mkdir -p "$OUT"
+if [ -f "$OUT/setting.tsv" ]; then  # tables of another setting are not reused
+  was=$(awk -F'\t' '$1 == "size" || $1 == "seeds" { printf "%s ", $2 }' "$OUT/setting.tsv")
+  [ "$was" = "$SIZE $SEEDS " ] || {
+    echo "run_ablation.sh: $OUT holds tables of size/seeds $was; use another --out" >&2
+    exit 2
+  }
+fi
 done_already() {  # the table exists with its family means
   [ -f "$OUT/$1.tsv" ] && grep -q $'\tMEAN\t' "$OUT/$1.tsv"
 }
@@ -82,13 +89,11 @@ run() {
   BUILD_ARG=(--skip-build)
 }
 done_already default || run --tag default
-if [ -z "$SWITCHES" ]; then
-  SWITCHES=$("${BUILD_DIR:-$ROOT/build-bench}/bin/wild_mvs" reconstruct --dump-config |
-    awk '/^ablation:/ { on = 1; next } /^[^ #]/ { on = 0 }
-         on && /^  [a-z_]+:/ { sub(":", "", $1); print $1 }')
-  [ -n "$SWITCHES" ] || { echo "run_ablation.sh: no ablation switches found" >&2; exit 1; }
-fi
-[ "$SWITCHES" != none ] || SWITCHES=""
+REGISTERED=$("${BUILD_DIR:-$ROOT/build-bench}/bin/wild_mvs" reconstruct --dump-config |
+  awk '/^ablation:/ { on = 1; next } /^[^ #]/ { on = 0 }
+       on && /^  [a-z_]+:/ { sub(":", "", $1); print $1 }')
+[ -n "$REGISTERED" ] || { echo "run_ablation.sh: no ablation switches found" >&2; exit 1; }
+case "$SWITCHES" in "") SWITCHES=$REGISTERED ;; none) SWITCHES="" ;; esac
 [ "$MOVES" != none ] || MOVES=""
 for s in $SWITCHES; do
   done_already "no_$s" || run --tag "no_$s" -- "--ablation.$s" false
@@ -102,6 +107,19 @@ for m in $MOVES; do
   done_already "set_${key}_$value" ||
     run --tag "set_${key}_$value" ${from[@]+"${from[@]}"} -- "--$key" "$value"
 done
+# What OUT holds (also from earlier calls): the switches in the tool's order,
+# the moves in the order they were first run.
+held_switches="" held_moves=""
+for s in $REGISTERED; do
+  ! done_already "no_$s" || held_switches+="${held_switches:+ }$s"
+done
+earlier=""
+[ ! -f "$OUT/setting.tsv" ] ||
+  earlier=$(awk -F'\t' '$1 == "moves" { print $2 }' "$OUT/setting.tsv")
+for m in $earlier $MOVES; do
+  case " $held_moves " in *" $m "*) continue ;; esac
+  ! done_already "set_${m%%=*}_${m#*=}" || held_moves+="${held_moves:+ }$m"
+done
 printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\n' "$SIZE" \
-  "$SEEDS" "$(echo $SWITCHES)" "$(echo $MOVES)" >"$OUT/setting.tsv"
+  "$SEEDS" "$held_switches" "$held_moves" >"$OUT/setting.tsv"
 echo "run_ablation.sh: tables in $OUT" >&2
