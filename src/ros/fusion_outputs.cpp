@@ -5,12 +5,9 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/Marker.h>
 
+#include "wild_mvs/core/meshing.h"
 #include "wild_mvs/ros/conversions.h"
 #include "wild_mvs/stream/cloud_file.h"
-#if __has_include("wild_mvs/core/meshing.h")
-#include "wild_mvs/core/meshing.h"
-#define WILD_MVS_HAVE_MESHING 1
-#endif
 
 namespace wild_mvs {
 namespace ros1 {
@@ -52,16 +49,14 @@ void FusionOutputs::PublishCloud(bool force) {
 }
 
 void FusionOutputs::PublishMesh() {
-#ifdef WILD_MVS_HAVE_MESHING
   PointCloud cloud;
   uint64_t stamp = 0;
   if (!session_->CloudIfChanged(&meshed_version_, false, &cloud, &stamp))
     return;
   if (cloud.size() < 100 || !cloud.has_normal()) return;
   try {
-    MeshingOptions mo;
-    mo.depth = 8;
-    Mesh mesh = MeshPointCloud(cloud, mo);
+    // The offline tool's meshing step, with the same options.
+    Mesh mesh = MeshPointCloud(cloud, options_.meshing);
     visualization_msgs::Marker m = MeshToMarker(mesh);
     m.header.stamp.fromNSec(stamp);
     m.header.frame_id = options_.world_frame;
@@ -71,7 +66,6 @@ void FusionOutputs::PublishMesh() {
     ROS_WARN_THROTTLE(30, "%s: meshing failed: %s", pnh_.getNamespace().c_str(),
                       e.what());
   }
-#endif
 }
 
 size_t FusionOutputs::Save(const std::string& path) {

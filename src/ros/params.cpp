@@ -199,6 +199,7 @@ void FusionNodeOptions::Check() const {
           "max_published_points = ", max_published_points, " must be >= 0");
   keyframes.Check();
   session.Check();
+  meshing.Check();
 }
 
 void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
@@ -352,6 +353,7 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
   // The core's fusion options, with the node's smaller memory budgets
   // (map_cache_mb 256, pending_mb 128; the CLI's are 512 and 256).
   RegisterOptions(registry, key("fusion"), &o->session.fusion);
+  RegisterOptions(registry, key("meshing"), &o->meshing);
 }
 
 DepthNodeOptions ReadDepthNodeOptions(const ParamSource& params,

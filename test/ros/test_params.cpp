@@ -27,6 +27,9 @@ TEST(Params, DefaultsAreValid) {
   const FusionNodeOptions f = ReadFusionNodeOptions(none);
   EXPECT_EQ(f.session.fusion.min_support, FusionOptions().min_support);
   EXPECT_EQ(f.session.on_new_session, "keep");
+  // The live mesh is the offline mesh: the core's meshing defaults.
+  EXPECT_EQ(f.meshing.depth, MeshingOptions().depth);
+  EXPECT_DOUBLE_EQ(f.meshing.trim_distance, MeshingOptions().trim_distance);
 }
 
 TEST(Params, ValuesReachTheCoreOptions) {
@@ -66,12 +69,16 @@ TEST(Params, ValuesReachTheCoreOptions) {
   MapParamSource q({{"publish_period", 0.5},
                     {"output_path", std::string("/tmp/x.ply")},
                     {"fusion/min_support", 2},
-                    {"fusion/depth_tolerance", 0.02}});
+                    {"fusion/depth_tolerance", 0.02},
+                    {"meshing/depth", 7},
+                    {"meshing/min_component_faces", 20}});
   const FusionNodeOptions f = ReadFusionNodeOptions(q);
   EXPECT_DOUBLE_EQ(f.publish_period, 0.5);
   EXPECT_EQ(f.session.output_path, "/tmp/x.ply");
   EXPECT_EQ(f.session.fusion.min_support, 2);
   EXPECT_DOUBLE_EQ(f.session.fusion.depth_tolerance, 0.02);
+  EXPECT_EQ(f.meshing.depth, 7);
+  EXPECT_EQ(f.meshing.min_component_faces, 20);
 }
 
 // What rosparam makes of a YAML document loaded into a namespace: nested
@@ -274,8 +281,11 @@ TEST(Params, ReconstructYamlSectionsLoadIntoTheNodes) {
     }
     EXPECT_GE(known, 1) << section;
   }
+  // The CLI's fusion and meshing sections are the fusion node's, key for
+  // key.
   YAML::Node fusion;
   fusion["fusion"] = all["fusion"];
+  fusion["meshing"] = all["meshing"];
   EXPECT_TRUE(UnknownFusionNodeParams(ParamsFromYaml(fusion)).empty());
 
   const std::string tuned =

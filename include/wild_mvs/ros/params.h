@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "wild_mvs/core/fusion.h"
+#include "wild_mvs/core/meshing.h"
 #include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/stream/fusion_session.h"
 #include "wild_mvs/stream/keyframe_ledger.h"
@@ -211,6 +212,10 @@ struct FusionNodeOptions {
   // pending samples 128 MB (256). With map_store_mb the node's bounded
   // memory is 640 MB plus the cloud.
   FusionSessionOptions session = NodeSessionDefaults();
+  // The mesh Marker's Poisson reconstruction and trimming: the core's
+  // meshing options, the section meshing/ (the CLI's meshing.* keys, the
+  // same defaults, so the live mesh is the offline mesh of the same cloud).
+  MeshingOptions meshing;
   void Check() const;
 
   static FusionSessionOptions NodeSessionDefaults() {
