@@ -260,7 +260,45 @@ def thresholds_section(abl_dir, default_rows, setting):
                         [cell(moved[f]) if f in moved else "-" for f in fams] +
                         [verdict(rows, keys, high)])
         md += [table(["option, value"] + fams + ["at least as good on"], body), ""]
+    md += fountain_moves(abl_dir, setting)
     return md
+
+
+def fountain_moves(abl_dir, setting):
+    """The wide-window thresholds moved on fountain-P11 at 1536 px: coverage
+    within 1 % (coverage x within 1 % of the estimates), off > 5 % and
+    background beside the default run's."""
+    moves = [m.split("=", 1) for m in setting.get("wide_moves", "").split()]
+    base = read_tsv(os.path.join(abl_dir, "fountain_default", "fountain.tsv"))
+    if not moves or not base:
+        return ["The `wide_*` thresholds: not run (fountain-P11 absent or "
+                "`--wide-moves none`).", ""]
+    keys = ["cmp", "off>5%", "background"]
+
+    def row(rows):
+        r = dict(rows[0])
+        r["cmp"] = str(num(r["coverage"]) * num(r["within1%"]))
+        return r
+    b = row(base)
+    cell = lambda r: (f"{pct(r['cmp'], 1)} / {pct(r['off>5%'])} / "
+                      f"{pct(r['background'])}")
+    body = [["defaults", cell(b), "-"]]
+    for k, v in moves:
+        rows = read_tsv(os.path.join(abl_dir, f"fountain_set_{k}_{v}", "fountain.tsv"))
+        if not rows:
+            body.append([f"`{k}` {v}", "not run", "-"])
+            continue
+        r = row(rows)
+        a = [round(num(r[x]), 4) for x in keys]
+        d = [round(num(b[x]), 4) for x in keys]
+        verdict = ("no change" if a == d else
+                   "yes" if a[0] >= d[0] and a[1] <= d[1] and a[2] <= d[2] else "no")
+        body.append([f"`{k}` {v}", cell(r), verdict])
+    return ["The wide-window thresholds (`mvs.*.wide_*`, used from 1200 px) on "
+            "fountain-P11 at 1536x1024 (`bench/run_fountain.sh`): coverage within 1 % "
+            "(coverage x within 1 % of the estimates) / off by more than 5 % / "
+            "background estimates:", "",
+            table(["option, value", "fountain-P11", "at least as good"], body), ""]
 
 
 def main():

@@ -12,13 +12,16 @@
 # policy deletes or makes the default (after the same result on other
 # seeds). Moves of consistency.* and fusion.* start from the default run's
 # raw depth maps (run_families.sh --from): the matching is the same.
-# A table that already has its family means in OUT is not run again
-# (delete it to redo it).
+# The wide_* thresholds apply only to images of 1200 px and more: they are
+# moved on fountain-P11 at 1536 px instead (bench/run_fountain.sh into
+# OUT/fountain_default and OUT/fountain_set_KEY_VALUE; skipped with a note
+# when the datasets are absent). A table that already has its family means
+# (or a fountain.tsv) in OUT is not run again (delete it to redo it).
 #
 # Usage: bench/run_ablation.sh [--seeds report|S1,S2..] [--size 320]
 #          [--families "relief weak courtyard"] [--switches "a b ..|none"]
-#          [--moves "KEY=VALUE ..|none"] [--threads 2] [--out DIR]
-#          [--skip-build]
+#          [--moves "KEY=VALUE ..|none"] [--wide-moves "KEY=VALUE ..|none"]
+#          [--threads 2] [--out DIR] [--skip-build]
 # Defaults: report seeds, images 320x240, every switch, the moves below.
 # A switch or a move of a matching option costs the time of one family run
 # (about 3 min on 2 idle cores); a move of a filter or fusion option a
@@ -53,6 +56,8 @@ MOVES="mvs.local.min_ncc=0.2 mvs.local.min_ncc=0.4
   fusion.depth_tolerance=0.005 fusion.depth_tolerance=0.02
   fusion.reprojection_tolerance_px=1 fusion.reprojection_tolerance_px=4
   fusion.normal_tolerance_deg=10 fusion.normal_tolerance_deg=40"
+WIDE_MOVES="mvs.local.wide_min_ncc=0.06 mvs.local.wide_min_ncc=0.2
+  mvs.mpgc.wide_drop_ncc=0.12 mvs.mpgc.wide_drop_ncc=0.32"
 THREADS=2
 OUT="$ROOT/build-bench/ablation"
 BUILD_ARG=()
@@ -63,6 +68,7 @@ while [ $# -gt 0 ]; do
     --families) FAMILIES="$2"; shift 2 ;;
     --switches) SWITCHES="$2"; shift 2 ;;
     --moves) MOVES="$2"; shift 2 ;;
+    --wide-moves) WIDE_MOVES="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --skip-build) BUILD_ARG=(--skip-build); shift ;;
@@ -71,6 +77,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
 if [ -f "$OUT/setting.tsv" ]; then  # tables of another setting are not reused
   was=$(awk -F'\t' '$1 == "size" || $1 == "seeds" { printf "%s ", $2 }' "$OUT/setting.tsv")
   [ "$was" = "$SIZE $SEEDS " ] || {
@@ -107,6 +114,30 @@ for m in $MOVES; do
   done_already "set_${key}_$value" ||
     run --tag "set_${key}_$value" ${from[@]+"${from[@]}"} -- "--$key" "$value"
 done
+[ "$WIDE_MOVES" != none ] || WIDE_MOVES=""
+DATASETS="${WILD_MVS_DATASETS:-$ROOT/../shared/datasets}"
+if [ -n "$WIDE_MOVES" ] && [ ! -d "$DATASETS/strecha_fountain-P11" ]; then
+  echo "run_ablation.sh: no fountain-P11 in $DATASETS: the wide_* moves are not run" >&2
+  WIDE_MOVES=""
+fi
+fountain() {  # TAG [EXTRA reconstruct ARGS]
+  local tag="$1"
+  shift
+  [ ! -f "$OUT/fountain_$tag/fountain.tsv" ] || return 0
+  mkdir -p "$OUT/fountain_$tag"
+  # The ground-truth cloud is the same for every run: made once.
+  [ ! -f "$OUT/fountain_default/gt_cloud_s2_v0.005.ply" ] || [ "$tag" = default ] ||
+    ln -sf "$OUT/fountain_default/gt_cloud_s2_v0.005.ply" "$OUT/fountain_$tag/"
+  bash "$ROOT/bench/run_fountain.sh" --size 1536 --threads "$THREADS" \
+    --out "$OUT/fountain_$tag" -- "$@" >&2
+}
+if [ -n "$WIDE_MOVES" ]; then
+  fountain default
+  for m in $WIDE_MOVES; do
+    key=${m%%=*} value=${m#*=}
+    fountain "set_${key}_$value" "--$key" "$value"
+  done
+fi
 # What OUT holds (also from earlier calls): the switches in the tool's order,
 # the moves in the order they were first run.
 held_switches="" held_moves=""
@@ -120,6 +151,14 @@ for m in $earlier $MOVES; do
   case " $held_moves " in *" $m "*) continue ;; esac
   ! done_already "set_${m%%=*}_${m#*=}" || held_moves+="${held_moves:+ }$m"
 done
-printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\n' "$SIZE" \
-  "$SEEDS" "$held_switches" "$held_moves" >"$OUT/setting.tsv"
+held_wide=""
+earlier=""
+[ ! -f "$OUT/setting.tsv" ] ||
+  earlier=$(awk -F'\t' '$1 == "wide_moves" { print $2 }' "$OUT/setting.tsv")
+for m in $earlier $WIDE_MOVES; do
+  case " $held_wide " in *" $m "*) continue ;; esac
+  [ ! -f "$OUT/fountain_set_${m%%=*}_${m#*=}/fountain.tsv" ] || held_wide+="${held_wide:+ }$m"
+done
+printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\nwide_moves\t%s\n' \
+  "$SIZE" "$SEEDS" "$held_switches" "$held_moves" "$held_wide" >"$OUT/setting.tsv"
 echo "run_ablation.sh: tables in $OUT" >&2

@@ -17,7 +17,8 @@
 #   families  bench/run_families.sh: the rendered scene families with
 #             exact ground truth (relief, weak, courtyard), report seeds;
 #   ablation  bench/run_ablation.sh: the same families at 320x240 with each
-#             mechanism of the method switched off in turn;
+#             mechanism of the method switched off in turn and each
+#             threshold moved one step (the wide-window ones on fountain-P11);
 #   scale     bench/run_scale.sh: CPU-s per view and peak RSS against the
 #             number of views (100 / 250 / 500);
 #   live      bench/run_live.sh: the depth and fusion nodes on a bag of a
@@ -157,9 +158,9 @@ if ! skipped families; then
   fi
 fi
 if ! skipped ablation; then
-  ABLATION_SEEDS=report
-  [ "$QUICK" = 0 ] || ABLATION_SEEDS=101
-  bash "$ROOT/bench/run_ablation.sh" --skip-build --seeds "$ABLATION_SEEDS" \
+  ABLATION_ARGS=(--seeds report)
+  [ "$QUICK" = 0 ] || ABLATION_ARGS=(--seeds 101 --wide-moves none)
+  bash "$ROOT/bench/run_ablation.sh" --skip-build "${ABLATION_ARGS[@]}" \
     --threads "$THREADS" --out "$OUT/ablation" || failed ablation
 fi
 SCALE_ARGS="--sizes $SCALE_SIZES --max-image-size $SCALE_PX --threads $THREADS"
