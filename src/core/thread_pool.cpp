@@ -4,13 +4,19 @@
 #include <atomic>
 #include <exception>
 
+#ifdef __linux__
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
 namespace wild_mvs {
 
-ThreadPool::ThreadPool(int num_threads) {
+ThreadPool::ThreadPool(int num_threads, Priority priority) {
   if (num_threads <= 0)
     num_threads = std::max(1u, std::thread::hardware_concurrency());
   for (int i = 0; i < num_threads; ++i)
-    workers_.emplace_back([this] { Loop(); });
+    workers_.emplace_back([this, priority] { Loop(priority); });
 }
 
 ThreadPool::~ThreadPool() {
@@ -22,7 +28,15 @@ ThreadPool::~ThreadPool() {
   for (auto& w : workers_) w.join();
 }
 
-void ThreadPool::Loop() {
+void ThreadPool::Loop(Priority priority) {
+#ifdef __linux__
+  // Per thread on Linux (the nice value of a thread id); raising it needs
+  // no privilege. Failure leaves the normal priority: only slower.
+  if (priority == Priority::kBackground)
+    (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+#else
+  (void)priority;
+#endif
   for (;;) {
     std::function<void()> task;
     {

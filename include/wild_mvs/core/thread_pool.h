@@ -17,8 +17,18 @@ namespace wild_mvs {
 
 class ThreadPool {
  public:
+  // How the workers compete for the CPU with the process's other threads.
+  enum class Priority {
+    kNormal,
+    // The lowest scheduling priority (Linux: nice 19 on each worker
+    // thread; elsewhere as kNormal): work that must yield the cores to the
+    // process's normal threads whenever they have work, such as a stream's
+    // revisions beside its first matches.
+    kBackground,
+  };
   // num_threads <= 0 means std::thread::hardware_concurrency().
-  explicit ThreadPool(int num_threads = 0);
+  explicit ThreadPool(int num_threads = 0,
+                      Priority priority = Priority::kNormal);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
@@ -46,7 +56,7 @@ class ThreadPool {
   void ParallelFor(int n, const std::function<void(int)>& body);
 
  private:
-  void Loop();
+  void Loop(Priority priority);
   std::vector<std::thread> workers_;
   std::queue<std::function<void()>> tasks_;
   std::mutex mutex_;
