@@ -545,7 +545,8 @@ def main():
                "step) and the saved fused cloud, against the ground truth. Views = "
                "views with a depth map; CPU-s of the live run include ROS. First "
                "depth s: from an image to its keyframe's first depth view (median / "
-               "max, the bag's clock); revised after: how many newer keyframes got "
+               "max, the bag's clock, which runs on 5 s past the last view); revised "
+               "after: how many newer keyframes got "
                "their first depth view before a keyframe's final revision (median / "
                "max).", ""]
         md += [table(["scene", "seed", "run", "views", "coverage", "within 1 %",

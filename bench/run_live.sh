@@ -158,6 +158,19 @@ for family in $FAMILIES; do
     [ "$SPARSE" = topic ] && points=(--with-points)
     "$BIN/wild_mvs_to_bag" "$scene" "$run/scene.bag" --rate "$RATE" \
       ${points[@]+"${points[@]}"} ${ROBOT[@]+"${ROBOT[@]}"} >"$run/bag.log" 2>&1
+    # The bag's clock (/clock, which the recorder stamps with) stops at its
+    # last message: a last, unused message 5 s after the last view keeps it
+    # running while the last keyframes are matched, so that their latency
+    # is measured, not cut off.
+    /usr/bin/python3 - "$run/scene.bag" <<'PY'
+import sys
+import rosbag
+import rospy
+from std_msgs.msg import String
+with rosbag.Bag(sys.argv[1], "a") as bag:
+    bag.write("/bench/clock_tail", String(data="keeps the clock running"),
+              rospy.Time.from_sec(bag.get_end_time() + 5.0))
+PY
     roscore -p "$PORT" >"$run/roscore.log" 2>&1 &
     core=$!
     sleep 3
