@@ -70,8 +70,13 @@ StreamReconstructor::StreamReconstructor(const StreamOptions& options,
   if (options_.use_tracker)
     tracker_ = std::make_unique<SparseTracker>(options_.tracker, nullptr);
   dispatcher_ = std::make_unique<ThreadPool>(1);
-  if (options_.reconstruct && options_.num_threads > 1)
+  revision_dispatcher_ =
+      std::make_unique<ThreadPool>(1, ThreadPool::Priority::kBackground);
+  if (options_.reconstruct && options_.num_threads > 1) {
     inner_pool_ = std::make_unique<ThreadPool>(options_.num_threads - 1);
+    revision_pool_ = std::make_unique<ThreadPool>(
+        options_.num_threads - 1, ThreadPool::Priority::kBackground);
+  }
   last_keyframe_wall_ = WallSeconds();
 }
 
@@ -88,8 +93,11 @@ void StreamReconstructor::Shutdown() {
   // A running depth map stops within a few pixels per tile (a node shutting
   // down must end within roslaunch's SIGINT-to-SIGKILL escalation).
   cancel_ = true;
-  dispatcher_.reset();  // queued tasks return at once; waits for a running one
+  // Queued tasks return at once; waits for a running one.
+  dispatcher_.reset();
+  revision_dispatcher_.reset();
   inner_pool_.reset();
+  revision_pool_.reset();
 }
 
 void StreamReconstructor::ClearLocked() {
@@ -99,6 +107,7 @@ void StreamReconstructor::ClearLocked() {
   in_flight_.clear();
   maps_.clear();
   unrevised_.clear();
+  held_.clear();
   rematched_.clear();
   revising_.clear();
   ++generation_;
@@ -391,10 +400,13 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
     if (!kf->owned || in_flight_.count(kf->id)) continue;
     if (kf->reconstructions > 0) continue;
     const Neighborhood nb = Evaluate(snap, static_cast<int>(i), idle);
-    // MPGC needs min_active_views neighbours to match at all.
-    if (nb.good <
-        std::max(options_.min_neighbors, options_.mvs.mpgc.min_active_views))
-      continue;
+    // A final first map needs the active views MPGC asks for; a preview
+    // asks for no more than it has (RunReconstruction).
+    const int needed = options_.mvs.ablation.consistency
+                           ? options_.min_neighbors
+                           : std::max(options_.min_neighbors,
+                                      options_.mvs.mpgc.min_active_views);
+    if (nb.good < needed) continue;
     if (static_cast<int>(in_flight_.size()) >= options_.max_pending) {
       ++ready_waiting_;  // ready, waits for a free slot
       continue;
@@ -402,15 +414,17 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
     in_flight_.insert(kf->id);
     const uint32_t id = kf->id;
     const uint64_t gen = generation_;
-    dispatcher_->Submit([this, id, gen] { RunReconstruction(id, gen); });
+    const int good = nb.good;
+    dispatcher_->Submit(
+        [this, id, gen, good] { RunReconstruction(id, gen, good); });
   }
 }
 
 void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
-  // First matches go first (a new keyframe's map is what a robot waits
-  // for); then one revision step at a time, so a new keyframe waits for at
-  // most one.
-  if (stopping_ || !in_flight_.empty() || !revising_.empty()) return;
+  // One revision step at a time, beside the first matches (a new
+  // keyframe's map is what a robot waits for: the revisions' threads have
+  // background priority).
+  if (stopping_ || !revising_.empty()) return;
   // A neighbour is settled for step `rematched` when the store no longer
   // holds it, another worker owns it, its matching failed, or it reached
   // that step.
@@ -455,7 +469,7 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
       continue;
     revising_.insert(id);
     const uint64_t gen = generation_;
-    dispatcher_->Submit([this, rid, gen, rematched] {
+    revision_dispatcher_->Submit([this, rid, gen, rematched] {
       if (rematched) {
         RunRevisionFilter(rid, gen);
       } else {
@@ -477,11 +491,13 @@ void StreamReconstructor::EndRevisionStepLocked(uint32_t id) {
 void StreamReconstructor::ForgetLocked(uint32_t id) {
   maps_.erase(id);
   unrevised_.erase(id);
+  held_.erase(id);
   rematched_.erase(id);
 }
 
 double StreamReconstructor::MatchKeyframe(const Snapshot& snap, int ref,
                                           const MvsOptions& mvs,
+                                          ThreadPool* pool,
                                           StreamResult* result) {
   const std::vector<KeyframePtr>& kfs = snap.keyframes;
   ImageCache cache([&kfs](int v) { return kfs.at(v)->image; }, 512);
@@ -490,8 +506,7 @@ double StreamReconstructor::MatchKeyframe(const Snapshot& snap, int ref,
   problem.ref = ref;
   problem.images = &cache;
   problem.points_per_view = &snap.points_per_view;
-  ViewResult matched =
-      DepthController(mvs, inner_pool_.get(), &cancel_).Match(problem);
+  ViewResult matched = DepthController(mvs, pool, &cancel_).Match(problem);
   result->depth = std::move(matched.map);
   const ViewReport& report = matched.report;
   result->depth.view = static_cast<int>(kfs[ref]->id);
@@ -524,6 +539,9 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
       return;
     }
     result = it->second;
+    // A preview still held (a neighbour left the store unmatched) is
+    // superseded by this revision.
+    held_.erase(id);
     snap = MakeSnapshotLocked();
     for (size_t i = 0; i < snap.keyframes.size(); ++i)
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
@@ -534,7 +552,7 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
   // exist now (the offline view selection).
   std::string error;
   try {
-    if (ref >= 0) MatchKeyframe(snap, ref, mvs, &result);
+    if (ref >= 0) MatchKeyframe(snap, ref, mvs, revision_pool_.get(), &result);
   } catch (const Cancelled&) {
     std::lock_guard<std::mutex> lock(mutex_);
     --stats_.running;
@@ -626,7 +644,8 @@ void StreamReconstructor::Tick() {
   idle_scheduled_ = true;
 }
 
-void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
+void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation,
+                                            int good) {
   Snapshot snap;
   KeyframePtr kf;
   int ref = -1;
@@ -655,6 +674,8 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
     mvs = options_.mvs;  // SetOptions may change it meanwhile
     ++stats_.running;
   }
+  const bool check_first =
+      mvs.ablation.consistency && good < mvs.mpgc.min_active_views;
   // With a revision to follow, the first map is a preview at half the
   // working size (a quarter of the pixels) without the coarse fill (its
   // own half-size pass would delay it): out fast, replaced by the
@@ -668,6 +689,10 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       mvs.max_image_size = working / 2;
       mvs.ablation.coarse_fill = false;
     }
+    // As many active views as it has neighbours: at a stream's start, a
+    // two-view preview rather than none until a fourth keyframe arrives.
+    mvs.mpgc.min_active_views =
+        std::max(1, std::min(mvs.mpgc.min_active_views, good));
   }
   StreamResult result;
   result.keyframe_id = id;
@@ -681,7 +706,7 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   double score = 0;
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    score = MatchKeyframe(snap, ref, mvs, &result);
+    score = MatchKeyframe(snap, ref, mvs, inner_pool_.get(), &result);
   } catch (const Cancelled&) {
     std::lock_guard<std::mutex> lock(mutex_);
     --stats_.running;
@@ -699,7 +724,6 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     --stats_.running;
-    in_flight_.erase(id);
     if (generation != generation_) {
       ++stats_.stale_results;
     } else if (!error.empty()) {
@@ -719,15 +743,76 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation) {
       total_seconds_ += result.seconds;
       stats_.last_seconds = result.seconds;
       stats_.mean_seconds = total_seconds_ / stats_.reconstructed;
-      deliver = true;
+      if (check_first) {
+        held_[id] = result;
+      } else {
+        deliver = true;
+      }
     }
   }
   if (!error.empty() && on_error_)
     on_error_(Msg("keyframe ", id, ": reconstruction failed: ", error));
   if (deliver && on_result_) on_result_(result);
+  // This map may be what held previews wait for. Still in in_flight_:
+  // WaitIdle returns only after they are delivered.
+  DeliverCheckedPreviews(generation);
   std::lock_guard<std::mutex> lock(mutex_);
+  in_flight_.erase(id);
   ScheduleLocked();
   idle_cv_.notify_all();
+}
+
+void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation) {
+  for (;;) {
+    StreamResult result;
+    MemoryDepthWorkspace workspace;
+    MvsOptions mvs;
+    int maps = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (stopping_ || generation != generation_) return;
+      // A neighbour is done when it has a map, or never will here (left
+      // the store, owned by another worker, its matching failed).
+      auto done = [this](uint32_t n) {
+        if (maps_.count(n)) return true;
+        const KeyframePtr k = store_.Get(n);
+        return !k || !k->owned || k->reconstructions > 0;
+      };
+      auto it = std::find_if(held_.begin(), held_.end(), [&](const auto& h) {
+        const std::vector<uint32_t>& n = h.second.neighbor_ids;
+        return std::all_of(n.begin(), n.end(), done);
+      });
+      if (it == held_.end()) return;
+      result = std::move(it->second);
+      held_.erase(it);
+      for (uint32_t n : result.neighbor_ids) {
+        auto m = maps_.find(n);
+        if (m == maps_.end() || n == result.keyframe_id) continue;
+        workspace.Put(DepthWorkspace::Stage::kRaw, static_cast<int>(n),
+                      m->second);
+        ++maps;
+      }
+      mvs = options_.mvs;
+    }
+    // Consistent with as many neighbours' maps as it asks for, or with all
+    // of them when it has fewer (none: nothing is confirmed).
+    mvs.consistency.min_consistent =
+        std::max(1, std::min(mvs.consistency.min_consistent, maps));
+    std::string error;
+    try {
+      result.depth =
+          DepthController(mvs, nullptr).Filter(result.depth, workspace).map;
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    if (!error.empty()) {
+      if (on_error_)
+        on_error_(Msg("keyframe ", result.keyframe_id,
+                      ": checking its preview failed: ", error));
+      continue;  // its revision still follows
+    }
+    if (on_result_) on_result_(result);
+  }
 }
 
 void StreamReconstructor::WaitIdle() {
@@ -858,7 +943,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
         .Min(1);
     registry
         ->Add(key("min_neighbors"), &o->min_neighbors,
-              "good neighbours (global view selection) before reconstructing")
+              "good neighbours (global view selection) before a keyframe's "
+              "first map (a preview when a revision follows)")
         .Min(1);
     registry
         ->Add(key("lookahead"), &o->lookahead,

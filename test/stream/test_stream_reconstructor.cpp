@@ -237,6 +237,48 @@ TEST(StreamReconstructor, FinalRevisionsAreTheOfflinePipelines) {
   EXPECT_GT(live_final.coverage(), offline.coverage() - 0.02);
 }
 
+// A stream's first keyframe has one neighbour when the second arrives. By
+// default (min_neighbors 1, a revision to follow) both are previewed from
+// those two views at once, instead of waiting for a fourth keyframe; with
+// the consistency step off there is no revision, and a first map is final:
+// it waits for mvs.mpgc.min_active_views neighbours.
+TEST(StreamReconstructor, FirstKeyframesArePreviewedFromTwoViews) {
+  const SyntheticScene& s = Scene6();
+  for (const bool consistency : {true, false}) {
+    StreamOptions o = FastOptions();
+    o.min_neighbors = StreamOptions().min_neighbors;  // the default
+    o.idle_flush = 1e3;                               // no idle flush
+    o.mvs.ablation.consistency = consistency;
+    Collector c;
+    StreamReconstructor stream(o, c.OnResult(), c.OnError());
+    stream.SetSparsePoints(StampedPoints(s));
+    for (size_t i = 0; i < 2; ++i)
+      stream.AddFrame(double(i), "camera", s.scene.views[i].camera,
+                      s.images[i]);
+    stream.WaitIdle();
+    EXPECT_TRUE(c.errors.empty()) << c.errors.front();
+    if (!consistency) {
+      EXPECT_TRUE(c.results.empty()) << "a final map from two views";
+      continue;
+    }
+    ASSERT_EQ(c.results.size(), 2u);
+    for (const StreamResult& r : c.results) {
+      EXPECT_EQ(r.revision, 0);
+      EXPECT_FALSE(r.final_revision);
+      const uint32_t other = 1 - r.keyframe_id;
+      EXPECT_EQ(r.neighbor_ids, std::vector<uint32_t>{other});
+      const int v = static_cast<int>(r.keyframe_id);
+      const DepthMetrics m = EvaluateDepth(r.depth.depth, r.depth.camera,
+                                           s.depth[v], s.scene.views[v].camera);
+      std::printf("two-view preview of keyframe %d: %s\n", v,
+                  m.ToString().c_str());
+      EXPECT_GT(m.completeness, 0.3) << "keyframe " << v;
+      EXPECT_LT(m.median_rel_error, 0.01) << "keyframe " << v;
+      EXPECT_GT(m.relative_accuracy[1], 0.8) << "keyframe " << v;  // 2 %
+    }
+  }
+}
+
 // Real-world stamps (epoch seconds with microseconds, 30 Hz) come back bit
 // for bit: a double cannot hold 1305031102.175304 exactly, so stamps must
 // never pass through one on their way to the outputs.

@@ -25,10 +25,13 @@
 // once those neighbours are matched again too (or at the idle flush), it is
 // checked against their maps (FilterByConsistency with mvs.consistency, the
 // offline filter on the maps offline would have) and delivered as revision
-// 1, same stamp. First matches go first; one revision step runs at a time,
-// when no first match is queued or running. Memory: the depth of every matched
-// keyframe held (4 bytes per pixel) and the first result of the keyframes
-// not yet revised; both go with the keyframe when the store evicts it.
+// 1, same stamp. One revision step runs at a time, beside the first
+// matches, on threads of background priority (ThreadPool::Priority): a first
+// match never waits for a revision and takes the cores whenever it runs.
+// Memory: the depth of every matched keyframe held (4 bytes per pixel), the
+// first result of the keyframes not yet revised (both go with the keyframe
+// when the store evicts it), and at most one first match and one revision
+// step in progress.
 //
 // Thread-safe: AddFrame / Tick / SetSparsePoints / Reset / Stats may be
 // called from any thread.
@@ -80,9 +83,16 @@ struct StreamOptions {
   // Good neighbours of a keyframe = the views the core's global view
   // selection (mvs.global) picks for it over the store with a positive
   // score (shared sparse points, parallax and resolution weights).
-  // Good neighbours before reconstructing (at least
-  // mvs.mpgc.min_active_views, which MPGC needs).
-  int min_neighbors = 3;
+  // Good neighbours before a keyframe's first map, >= 1. With a revision to
+  // follow (mvs.ablation.consistency) the first map is a preview and MPGC
+  // asks it for no more active views than it has good neighbours (so a
+  // stream's first keyframe is previewed as soon as a second one arrives).
+  // A preview from fewer than mvs.mpgc.min_active_views neighbours (a
+  // two-view match has no third view to reject a wrong depth) is held
+  // until its neighbours' previews exist and is delivered checked against
+  // them (FilterByConsistency: a left-right check for two views). Without
+  // a revision to follow, a keyframe waits for mvs.mpgc.min_active_views.
+  int min_neighbors = 1;
   // A keyframe is matched as soon as it has min_neighbors good neighbours.
   // Its revision waits until the keyframes up to `lookahead` after it have
   // `lookahead` later keyframes themselves and the store holds
@@ -294,15 +304,19 @@ class StreamReconstructor {
   Neighborhood Evaluate(const Snapshot& snap, int index, bool idle) const;
   void ScheduleLocked();  // matching, then revisions
   void ScheduleMatchingLocked(bool idle);
-  void RunReconstruction(uint32_t id, uint64_t generation);
+  // `good`: the good neighbours the keyframe had when it was scheduled.
+  void RunReconstruction(uint32_t id, uint64_t generation, int good);
   // Submits the revisions whose neighbours are done (see the file comment).
   void ScheduleRevisionsLocked(bool idle);
+  // Delivers the held previews (held_) whose neighbours all have a map
+  // or never will, each checked against those maps.
+  void DeliverCheckedPreviews(uint64_t generation);
   void RunRevisionMatch(uint32_t id, uint64_t generation);   // step 1
   void RunRevisionFilter(uint32_t id, uint64_t generation);  // step 2
   // Matches keyframe `ref` of `snap` (ReconstructView over the snapshot):
   // sets result->depth and its neighbours; returns the neighbour score.
   double MatchKeyframe(const Snapshot& snap, int ref, const MvsOptions& mvs,
-                       StreamResult* result);
+                       ThreadPool* pool, StreamResult* result);
   void ForgetLocked(uint32_t id);           // a keyframe left the store
   void EndRevisionStepLocked(uint32_t id);  // then schedules the next
   void ClearLocked();
@@ -324,6 +338,9 @@ class StreamReconstructor {
   std::map<uint32_t, std::shared_ptr<const DepthMap>> maps_;
   std::map<uint32_t, StreamResult> unrevised_;
   std::set<uint32_t> rematched_;  // held keyframes matched again (step 1)
+  // Previews from fewer than mvs.mpgc.min_active_views neighbours, waiting
+  // for their neighbours' maps (DeliverCheckedPreviews).
+  std::map<uint32_t, StreamResult> held_;
   std::set<uint32_t> revising_;
   int ready_waiting_ = 0;
   uint32_t next_id_ = 0;
@@ -340,8 +357,14 @@ class StreamReconstructor {
   Eigen::Vector3d last_center_{0, 0, 0};
   StreamStats stats_;
   double total_seconds_ = 0;
-  std::unique_ptr<ThreadPool> dispatcher_;  // one thread: reconstructions
-  std::unique_ptr<ThreadPool> inner_pool_;  // tiles inside one view
+  // First matches: one at a time on the dispatcher, its tiles on the
+  // inner pool. Revision steps: one at a time on the revision dispatcher
+  // and pool, both of background priority, so that a first match never
+  // waits for a revision and gets the cores whenever it runs.
+  std::unique_ptr<ThreadPool> dispatcher_;
+  std::unique_ptr<ThreadPool> inner_pool_;
+  std::unique_ptr<ThreadPool> revision_dispatcher_;
+  std::unique_ptr<ThreadPool> revision_pool_;
 };
 
 }  // namespace wild_mvs
