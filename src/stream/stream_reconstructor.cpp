@@ -113,6 +113,7 @@ void StreamReconstructor::ClearLocked() {
   ++generation_;
   next_id_ = 0;  // ids restart in the new session
   session_ = -1;
+  pose_jump_session_ = false;
   session_ns_ = 0;
   have_last_center_ = false;
   if (options_.use_tracker)
@@ -192,6 +193,7 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
         options_.max_pose_jump > 0 && stamp - last_stamp_ < 1.0 &&
         (center - last_center_).norm() > options_.max_pose_jump) {
       ClearLocked();
+      pose_jump_session_ = true;
       status = FrameStatus::kReset;
     }
     last_stamp_ = stamp;
@@ -401,8 +403,12 @@ void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
     if (kf->reconstructions > 0) continue;
     const Neighborhood nb = Evaluate(snap, static_cast<int>(i), idle);
     // A final first map needs the active views MPGC asks for; a preview
-    // asks for no more than it has (RunReconstruction).
-    const int needed = options_.mvs.ablation.consistency
+    // asks for no more than it has (RunReconstruction), except in a session
+    // a pose jump started, which may be a glitch that ends a frame later
+    // (a worker fed by a selector does not know why a session began).
+    const bool few_views_ok = options_.mvs.ablation.consistency &&
+                              options_.select_keyframes && !pose_jump_session_;
+    const int needed = few_views_ok
                            ? options_.min_neighbors
                            : std::max(options_.min_neighbors,
                                       options_.mvs.mpgc.min_active_views);

@@ -279,6 +279,56 @@ TEST(StreamReconstructor, FirstKeyframesArePreviewedFromTwoViews) {
   }
 }
 
+// A session that a pose jump started may be a glitch that ends a frame
+// later (its frames consistent with each other, not with the world): there
+// two keyframes make no preview; a keyframe waits for
+// mvs.mpgc.min_active_views neighbours, as without a revision to follow.
+TEST(StreamReconstructor, NoTwoViewPreviewsAfterAPoseJump) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.min_neighbors = StreamOptions().min_neighbors;
+  o.idle_flush = 1e3;
+  o.max_pose_jump = 1.0;
+  const Eigen::Vector3d jump(3.0, 0.0, 0.0);
+  // Frames 0 and 1 (stamps 0, 0.25), then frames 2 and 3 moved by 3 m
+  // (stamps 0.5, 0.75) with their sparse points moved alike: the second
+  // pair is as consistent as the first; only its session began at a jump.
+  std::vector<StreamReconstructor::StampedPoint> points;
+  for (const StreamReconstructor::StampedPoint& p : StampedPoints(s)) {
+    StreamReconstructor::StampedPoint before, after;
+    before.xyz = p.xyz;
+    after.xyz = p.xyz + jump;
+    for (const auto& obs : p.observations) {
+      if (obs.stamp < 2)
+        before.observations.push_back({obs.stamp * 0.25, obs.xy});
+      else if (obs.stamp < 4)
+        after.observations.push_back({obs.stamp * 0.25, obs.xy});
+    }
+    if (before.observations.size() >= 2) points.push_back(before);
+    if (after.observations.size() >= 2) points.push_back(after);
+  }
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  stream.SetSparsePoints(points);
+  for (int i = 0; i < 4; ++i) {
+    Camera camera = s.scene.views[i].camera;
+    if (i >= 2) camera.t -= camera.R * jump;  // centre moved by `jump`
+    const StreamReconstructor::FrameStatus status =
+        stream.AddFrame(0.25 * i, "camera", camera, s.images[i]);
+    EXPECT_EQ(status, i == 2 ? StreamReconstructor::FrameStatus::kReset
+                             : StreamReconstructor::FrameStatus::kKeyframe)
+        << "frame " << i;
+    if (i == 1) stream.WaitIdle();  // the first pair's previews
+  }
+  stream.WaitIdle();
+  EXPECT_TRUE(c.errors.empty()) << c.errors.front();
+  ASSERT_EQ(c.results.size(), 2u) << "previews after the jump";
+  for (const StreamResult& r : c.results) {
+    EXPECT_LT(r.stamp, 0.3) << "keyframe of the jumped session";
+    EXPECT_EQ(r.revision, 0);
+  }
+}
+
 // Real-world stamps (epoch seconds with microseconds, 30 Hz) come back bit
 // for bit: a double cannot hold 1305031102.175304 exactly, so stamps must
 // never pass through one on their way to the outputs.

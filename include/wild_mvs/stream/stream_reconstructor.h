@@ -91,7 +91,11 @@ struct StreamOptions {
   // two-view match has no third view to reject a wrong depth) is held
   // until its neighbours' previews exist and is delivered checked against
   // them (FilterByConsistency: a left-right check for two views). Without
-  // a revision to follow, a keyframe waits for mvs.mpgc.min_active_views.
+  // a revision to follow, or in a session that a pose jump started
+  // (max_pose_jump: it may be a glitch that ends a frame later, its frames
+  // consistent with each other but not with the world), or in a worker
+  // (select_keyframes false: it follows sessions without their cause), a
+  // keyframe waits for mvs.mpgc.min_active_views neighbours.
   int min_neighbors = 1;
   // A keyframe is matched as soon as it has min_neighbors good neighbours.
   // Its revision waits until the keyframes up to `lookahead` after it have
@@ -351,7 +355,8 @@ class StreamReconstructor {
                                      // flush ran since the last keyframe
   double last_keyframe_wall_ = 0;    // steady clock, s
   double last_stamp_ = -1;
-  double session_ = -1;  // see StreamResult::session
+  double session_ = -1;             // see StreamResult::session
+  bool pose_jump_session_ = false;  // the current session began at a jump
   uint64_t session_ns_ = 0;
   bool have_last_center_ = false;
   Eigen::Vector3d last_center_{0, 0, 0};
