@@ -211,9 +211,9 @@ def thresholds_section(abl_dir, default_rows, setting):
           "nothing anywhere marks an option these scenes do not exercise. The "
           "`mvs.*.wide_*` thresholds apply only to images of 1200 px and more.", ""]
     if not moves:
-        return md + ["Not run.", ""]
+        md += ["Not run.", ""]
 
-    def verdict(rows, keys, better_high):
+    def verdict(rows, keys, better_high, base=base):
         moved = means(rows)
         good, same = [], True
         for f in fams:
@@ -260,8 +260,43 @@ def thresholds_section(abl_dir, default_rows, setting):
                         [cell(moved[f]) if f in moved else "-" for f in fams] +
                         [verdict(rows, keys, high)])
         md += [table(["option, value"] + fams + ["at least as good on"], body), ""]
+    md += tracker_moves(abl_dir, setting, means, verdict)
     md += fountain_moves(abl_dir, setting)
     return md
+
+
+def tracker_moves(abl_dir, setting, means, verdict):
+    """The tracker's thresholds moved on the families rendered without
+    sparse points (the tool makes its own tracks), against that setting's
+    default run."""
+    moves = [m.split("=", 1) for m in setting.get("tracker_moves", "").split()]
+    default_rows = read_tsv(os.path.join(abl_dir, "tracker_default.tsv"))
+    if not moves or not default_rows:
+        return ["The tracker's thresholds: not run (`--tracker-moves none`).", ""]
+    base = means(default_rows)
+    fams = list(base)
+    keys, high = ["cmp@1%", "off>5%", "sky"], [True, False, False]
+
+    def cell(r):
+        return f"{pct(r['cmp@1%'], 1)} / {pct(r['off>5%'])}"
+    body = [["defaults"] + [cell(base[f]) for f in fams] + ["-"]]
+    for k, v in moves:
+        rows = read_tsv(os.path.join(abl_dir, f"tracker_set_{k}_{v}.tsv"))
+        if not rows:
+            body.append([f"`{k}` {v}"] + ["not run"] * len(fams) + ["-"])
+            continue
+        moved = means(rows)
+        body.append([f"`{k}` {v}"] +
+                    [cell(moved[f]) if f in moved else "-" for f in fams] +
+                    [verdict(rows, keys, high, base)])
+    return ["The tracker's thresholds, on the same families rendered without "
+            "sparse points (`bench/run_families.sh --points 0`; the tool makes "
+            "its own tracks, `--stages sparse,depth,fuse,mesh`, as from photos "
+            "alone): coverage within 1 % / estimates off by more than 5 %, "
+            "against the defaults in that setting "
+            "(`tracker.features.max_image_size`, 2000 px, does not act on these "
+            "images):", "",
+            table(["option, value"] + fams + ["at least as good on"], body), ""]
 
 
 def fountain_moves(abl_dir, setting):

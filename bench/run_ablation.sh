@@ -17,10 +17,16 @@
 # OUT/fountain_default and OUT/fountain_set_KEY_VALUE; skipped with a note
 # when the datasets are absent). A table that already has its family means
 # (or a fountain.tsv) in OUT is not run again (delete it to redo it).
+# The tracker's thresholds matter only where the tool makes its own tracks:
+# they are moved on the same families rendered without sparse points
+# (run_families.sh --points 0, `--stages sparse,depth,fuse,mesh`), against
+# that setting's own default run (OUT/tracker_default.tsv,
+# OUT/tracker_set_KEY_VALUE.tsv).
 #
 # Usage: bench/run_ablation.sh [--seeds report|S1,S2..] [--size 320]
 #          [--families "relief weak courtyard"] [--switches "a b ..|none"]
 #          [--moves "KEY=VALUE ..|none"] [--wide-moves "KEY=VALUE ..|none"]
+#          [--tracker-moves "KEY=VALUE ..|none"]
 #          [--threads 2] [--out DIR] [--skip-build]
 # Defaults: report seeds, images 320x240, every switch, the moves below.
 # A switch or a move of a matching option costs the time of one family run
@@ -58,6 +64,12 @@ MOVES="mvs.local.min_ncc=0.2 mvs.local.min_ncc=0.4
   fusion.normal_tolerance_deg=10 fusion.normal_tolerance_deg=40"
 WIDE_MOVES="mvs.local.wide_min_ncc=0.06 mvs.local.wide_min_ncc=0.2
   mvs.mpgc.wide_drop_ncc=0.12 mvs.mpgc.wide_drop_ncc=0.32"
+# tracker.features.max_image_size (2000 px) does not act on these sizes.
+TRACKER_MOVES="tracker.features.max_features=2000 tracker.features.max_features=8000
+  tracker.max_neighbors=6 tracker.max_neighbors=10
+  tracker.max_reprojection_error=1 tracker.max_reprojection_error=4
+  tracker.min_triangulation_angle_deg=1 tracker.min_triangulation_angle_deg=4
+  tracker.min_track_length=3"
 THREADS=2
 OUT="$ROOT/build-bench/ablation"
 BUILD_ARG=()
@@ -69,6 +81,7 @@ while [ $# -gt 0 ]; do
     --switches) SWITCHES="$2"; shift 2 ;;
     --moves) MOVES="$2"; shift 2 ;;
     --wide-moves) WIDE_MOVES="$2"; shift 2 ;;
+    --tracker-moves) TRACKER_MOVES="$2"; shift 2 ;;
     --threads) THREADS="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --skip-build) BUILD_ARG=(--skip-build); shift ;;
@@ -114,6 +127,18 @@ for m in $MOVES; do
   done_already "set_${key}_$value" ||
     run --tag "set_${key}_$value" ${from[@]+"${from[@]}"} -- "--$key" "$value"
 done
+[ "$TRACKER_MOVES" != none ] || TRACKER_MOVES=""
+OWN_TRACKS=(--points 0 -- --stages sparse,depth,fuse,mesh)
+if [ -n "$TRACKER_MOVES" ]; then
+  done_already tracker_default || run --tag tracker_default "${OWN_TRACKS[@]}"
+  for m in $TRACKER_MOVES; do
+    key=${m%%=*} value=${m#*=}
+    [ "$key" != "$m" ] && [ -n "$value" ] ||
+      { echo "run_ablation.sh: move $m is not KEY=VALUE" >&2; exit 2; }
+    done_already "tracker_set_${key}_$value" ||
+      run --tag "tracker_set_${key}_$value" "${OWN_TRACKS[@]}" "--$key" "$value"
+  done
+fi
 [ "$WIDE_MOVES" != none ] || WIDE_MOVES=""
 DATASETS="${WILD_MVS_DATASETS:-$ROOT/../shared/datasets}"
 if [ -n "$WIDE_MOVES" ] && [ ! -d "$DATASETS/strecha_fountain-P11" ]; then
@@ -159,6 +184,15 @@ for m in $earlier $WIDE_MOVES; do
   case " $held_wide " in *" $m "*) continue ;; esac
   [ ! -f "$OUT/fountain_set_${m%%=*}_${m#*=}/fountain.tsv" ] || held_wide+="${held_wide:+ }$m"
 done
-printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\nwide_moves\t%s\n' \
-  "$SIZE" "$SEEDS" "$held_switches" "$held_moves" "$held_wide" >"$OUT/setting.tsv"
+held_tracker=""
+earlier=""
+[ ! -f "$OUT/setting.tsv" ] ||
+  earlier=$(awk -F'\t' '$1 == "tracker_moves" { print $2 }' "$OUT/setting.tsv")
+for m in $earlier $TRACKER_MOVES; do
+  case " $held_tracker " in *" $m "*) continue ;; esac
+  ! done_already "tracker_set_${m%%=*}_${m#*=}" || held_tracker+="${held_tracker:+ }$m"
+done
+printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\nwide_moves\t%s\ntracker_moves\t%s\n' \
+  "$SIZE" "$SEEDS" "$held_switches" "$held_moves" "$held_wide" "$held_tracker" \
+  >"$OUT/setting.tsv"
 echo "run_ablation.sh: tables in $OUT" >&2

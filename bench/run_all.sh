@@ -18,7 +18,8 @@
 #             exact ground truth (relief, weak, courtyard), report seeds;
 #   ablation  bench/run_ablation.sh: the same families at 320x240 with each
 #             mechanism of the method switched off in turn and each
-#             threshold moved one step (the wide-window ones on fountain-P11);
+#             threshold moved one step (the wide-window ones on fountain-P11,
+#             the tracker's on the same families without sparse points);
 #   scale     bench/run_scale.sh: CPU-s per view and peak RSS against the
 #             number of views (100 / 250 / 500);
 #   live      bench/run_live.sh: the depth and fusion nodes on a bag of a
