@@ -108,6 +108,7 @@ void StreamReconstructor::ClearLocked() {
   maps_.clear();
   unrevised_.clear();
   held_.clear();
+  previewing_.clear();
   rematched_.clear();
   revising_.clear();
   ++generation_;
@@ -382,7 +383,22 @@ void StreamReconstructor::ScheduleLocked() {
   const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
   if (idle) idle_scheduled_ = true;
   ScheduleMatchingLocked(idle);
+  if (idle) FlushHeldPreviewsLocked();
   ScheduleRevisionsLocked(idle);
+}
+
+void StreamReconstructor::FlushHeldPreviewsLocked() {
+  if (stopping_ || held_.empty() || preview_flush_pending_) return;
+  // On the dispatcher: after the first matches queued before it.
+  preview_flush_pending_ = true;
+  const uint64_t gen = generation_;
+  dispatcher_->Submit([this, gen] {
+    DeliverCheckedPreviews(gen, /*idle=*/true);
+    std::lock_guard<std::mutex> lock(mutex_);
+    preview_flush_pending_ = false;
+    ScheduleLocked();
+    idle_cv_.notify_all();
+  });
 }
 
 void StreamReconstructor::ScheduleMatchingLocked(bool idle) {
@@ -448,6 +464,8 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
                           std::min(options_.mvs.global.num_neighbors,
                                    options_.store.max_keyframes - 1);
   for (const auto& [id, pending] : unrevised_) {
+    // Not before its preview went out (revision 0 comes first).
+    if (held_.count(id) || previewing_.count(id)) continue;
     // Step 1, matching again, once the neighbours of the first match are
     // matched, the store holds a full neighbourhood and the keyframes up to
     // `lookahead` after it have `lookahead` later keyframes themselves (the
@@ -545,9 +563,6 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
       return;
     }
     result = it->second;
-    // A preview still held (a neighbour left the store unmatched) is
-    // superseded by this revision.
-    held_.erase(id);
     snap = MakeSnapshotLocked();
     for (size_t i = 0; i < snap.keyframes.size(); ++i)
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
@@ -761,14 +776,15 @@ void StreamReconstructor::RunReconstruction(uint32_t id, uint64_t generation,
   if (deliver && on_result_) on_result_(result);
   // This map may be what held previews wait for. Still in in_flight_:
   // WaitIdle returns only after they are delivered.
-  DeliverCheckedPreviews(generation);
+  DeliverCheckedPreviews(generation, /*idle=*/false);
   std::lock_guard<std::mutex> lock(mutex_);
   in_flight_.erase(id);
   ScheduleLocked();
   idle_cv_.notify_all();
 }
 
-void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation) {
+void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation,
+                                                 bool idle) {
   for (;;) {
     StreamResult result;
     MemoryDepthWorkspace workspace;
@@ -778,11 +794,13 @@ void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (stopping_ || generation != generation_) return;
       // A neighbour is done when it has a map, or never will here (left
-      // the store, owned by another worker, its matching failed).
-      auto done = [this](uint32_t n) {
+      // the store, owned by another worker, its matching failed; at the
+      // idle flush also: not queued for matching).
+      auto done = [this, idle](uint32_t n) {
         if (maps_.count(n)) return true;
         const KeyframePtr k = store_.Get(n);
-        return !k || !k->owned || k->reconstructions > 0;
+        return !k || !k->owned || k->reconstructions > 0 ||
+               (idle && !in_flight_.count(n));
       };
       auto it = std::find_if(held_.begin(), held_.end(), [&](const auto& h) {
         const std::vector<uint32_t>& n = h.second.neighbor_ids;
@@ -791,6 +809,7 @@ void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation) {
       if (it == held_.end()) return;
       result = std::move(it->second);
       held_.erase(it);
+      previewing_.insert(result.keyframe_id);
       for (uint32_t n : result.neighbor_ids) {
         auto m = maps_.find(n);
         if (m == maps_.end() || n == result.keyframe_id) continue;
@@ -815,16 +834,21 @@ void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation) {
       if (on_error_)
         on_error_(Msg("keyframe ", result.keyframe_id,
                       ": checking its preview failed: ", error));
-      continue;  // its revision still follows
+    } else if (on_result_) {
+      on_result_(result);
     }
-    if (on_result_) on_result_(result);
+    // Its revision may go now (ScheduleRevisionsLocked waits for this).
+    std::lock_guard<std::mutex> lock(mutex_);
+    previewing_.erase(result.keyframe_id);
   }
 }
 
 void StreamReconstructor::WaitIdle() {
   std::unique_lock<std::mutex> lock(mutex_);
-  idle_cv_.wait(lock,
-                [this] { return in_flight_.empty() && revising_.empty(); });
+  idle_cv_.wait(lock, [this] {
+    return in_flight_.empty() && revising_.empty() && previewing_.empty() &&
+           !preview_flush_pending_;
+  });
 }
 
 StreamStats StreamReconstructor::Stats() const {

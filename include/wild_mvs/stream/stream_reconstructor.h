@@ -313,8 +313,11 @@ class StreamReconstructor {
   // Submits the revisions whose neighbours are done (see the file comment).
   void ScheduleRevisionsLocked(bool idle);
   // Delivers the held previews (held_) whose neighbours all have a map
-  // or never will, each checked against those maps.
-  void DeliverCheckedPreviews(uint64_t generation);
+  // or never will, each checked against those maps; `idle`: also those
+  // whose missing neighbours are not queued for matching.
+  void DeliverCheckedPreviews(uint64_t generation, bool idle);
+  // At the idle flush: DeliverCheckedPreviews(idle) on the dispatcher.
+  void FlushHeldPreviewsLocked();
   void RunRevisionMatch(uint32_t id, uint64_t generation);   // step 1
   void RunRevisionFilter(uint32_t id, uint64_t generation);  // step 2
   // Matches keyframe `ref` of `snap` (ReconstructView over the snapshot):
@@ -345,6 +348,8 @@ class StreamReconstructor {
   // Previews from fewer than mvs.mpgc.min_active_views neighbours, waiting
   // for their neighbours' maps (DeliverCheckedPreviews).
   std::map<uint32_t, StreamResult> held_;
+  std::set<uint32_t> previewing_;       // taken from held_, being delivered
+  bool preview_flush_pending_ = false;  // FlushHeldPreviewsLocked queued
   std::set<uint32_t> revising_;
   int ready_waiting_ = 0;
   uint32_t next_id_ = 0;
