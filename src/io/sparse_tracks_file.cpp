@@ -146,6 +146,8 @@ bool ReadSparseTracks(const std::string& path, const Scene& scene,
     }
     p.rgb = Eigen::Vector3f(static_cast<float>(r), static_cast<float>(g),
                             static_cast<float>(b));
+    // A colour beyond float's range would be written back as "inf".
+    if (!p.rgb.allFinite()) fail("bad point line (colour out of range)");
     for (long long j = 0; j < obs; ++j) {
       next();
       std::istringstream os(line);

@@ -16,6 +16,7 @@
 #include "wild_mvs/core/error.h"
 #include "wild_mvs/io/image_size.h"
 #include "wild_mvs/io/ply.h"
+#include "wild_mvs/io/sparse_tracks_file.h"
 
 namespace wild_mvs {
 namespace {
@@ -113,6 +114,40 @@ TEST(FuzzRegressions, PlyFaceIndexOverIntMaxIsRefused) {
         EXPECT_NE(what.find("refers to vertex"), std::string::npos) << what;
       }
     }
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// fuzz_sparse_tracks: a point colour of 1e57 was read (as a double, then
+// cast to float: inf) and written back as "inf", which the reader refuses:
+// the round trip threw. Fixed by refusing a colour beyond float's range.
+TEST(FuzzRegressions, SparseTrackColourOverFloatMaxIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/wild_mvs_fuzz_tracks";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/tracks.txt";
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << ReadCorpus("sparse_tracks", "crash_colour_over_float_max");
+  }
+  Scene scene;  // the harness's scene
+  for (const char* name : {"a.png", "b c.jpg"}) {
+    View v;
+    v.name = name;
+    v.camera.width = 64;
+    v.camera.height = 48;
+    scene.views.push_back(v);
+  }
+  std::vector<SparsePoint> points;
+  std::string why;
+  try {
+    ReadSparseTracks(path, scene,
+                     {"image.max_image_size 0", "dataset.mask_dir "}, &points,
+                     &why);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find("colour out of range"), std::string::npos) << what;
   }
   std::filesystem::remove_all(dir);
 }
