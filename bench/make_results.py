@@ -244,28 +244,32 @@ def thresholds_section(abl_dir, default_rows, setting):
                lambda k: k.startswith("fusion."),
                ["F@1cm", "F@5cm"], [True, True],
                lambda r: f"{pct(r['F@1cm'], 1)} / {pct(r['F@5cm'], 1)}")]
-    for title, member, keys, high, cell in groups:
-        chosen = [(k, v) for k, v in moves if member(k)]
-        if not chosen:
-            continue
-        md += [f"Options of the {title}:", ""]
+    def moves_table(chosen, prefix, base, keys, high, cell):
+        """A row per move (OUT/{prefix}set_KEY_VALUE.tsv) below `base`."""
         body = [["defaults"] + [cell(base[f]) for f in fams] + ["-"]]
         for k, v in chosen:
-            rows = read_tsv(os.path.join(abl_dir, f"set_{k}_{v}.tsv"))
+            rows = read_tsv(os.path.join(abl_dir, f"{prefix}set_{k}_{v}.tsv"))
             if not rows:
                 body.append([f"`{k}` {v}"] + ["not run"] * len(fams) + ["-"])
                 continue
             moved = means(rows)
             body.append([f"`{k}` {v}"] +
                         [cell(moved[f]) if f in moved else "-" for f in fams] +
-                        [verdict(rows, keys, high)])
-        md += [table(["option, value"] + fams + ["at least as good on"], body), ""]
-    md += tracker_moves(abl_dir, setting, means, verdict)
+                        [verdict(rows, keys, high, base)])
+        return table(["option, value"] + fams + ["at least as good on"], body)
+
+    for title, member, keys, high, cell in groups:
+        chosen = [(k, v) for k, v in moves if member(k)]
+        if not chosen:
+            continue
+        md += [f"Options of the {title}:", "",
+               moves_table(chosen, "", base, keys, high, cell), ""]
+    md += tracker_moves(abl_dir, setting, means, moves_table)
     md += fountain_moves(abl_dir, setting)
     return md
 
 
-def tracker_moves(abl_dir, setting, means, verdict):
+def tracker_moves(abl_dir, setting, means, moves_table):
     """The tracker's thresholds moved on the families rendered without
     sparse points (the tool makes its own tracks), against that setting's
     default run."""
@@ -273,22 +277,8 @@ def tracker_moves(abl_dir, setting, means, verdict):
     default_rows = read_tsv(os.path.join(abl_dir, "tracker_default.tsv"))
     if not moves or not default_rows:
         return ["The tracker's thresholds: not run (`--tracker-moves none`).", ""]
-    base = means(default_rows)
-    fams = list(base)
-    keys, high = ["cmp@1%", "off>5%", "sky"], [True, False, False]
-
     def cell(r):
         return f"{pct(r['cmp@1%'], 1)} / {pct(r['off>5%'])}"
-    body = [["defaults"] + [cell(base[f]) for f in fams] + ["-"]]
-    for k, v in moves:
-        rows = read_tsv(os.path.join(abl_dir, f"tracker_set_{k}_{v}.tsv"))
-        if not rows:
-            body.append([f"`{k}` {v}"] + ["not run"] * len(fams) + ["-"])
-            continue
-        moved = means(rows)
-        body.append([f"`{k}` {v}"] +
-                    [cell(moved[f]) if f in moved else "-" for f in fams] +
-                    [verdict(rows, keys, high, base)])
     return ["The tracker's thresholds, on the same families rendered without "
             "sparse points (`bench/run_families.sh --points 0`; the tool makes "
             "its own tracks, `--stages sparse,depth,fuse,mesh`, as from photos "
@@ -296,7 +286,8 @@ def tracker_moves(abl_dir, setting, means, verdict):
             "against the defaults in that setting "
             "(`tracker.features.max_image_size`, 2000 px, does not act on these "
             "images):", "",
-            table(["option, value"] + fams + ["at least as good on"], body), ""]
+            moves_table(moves, "tracker_", means(default_rows),
+                        ["cmp@1%", "off>5%", "sky"], [True, False, False], cell), ""]
 
 
 def fountain_moves(abl_dir, setting):

@@ -165,33 +165,30 @@ if [ -n "$WIDE_MOVES" ]; then
 fi
 # What OUT holds (also from earlier calls): the switches in the tool's order,
 # the moves in the order they were first run.
-held_switches="" held_moves=""
+held_switches=""
 for s in $REGISTERED; do
   ! done_already "no_$s" || held_switches+="${held_switches:+ }$s"
 done
-earlier=""
-[ ! -f "$OUT/setting.tsv" ] ||
-  earlier=$(awk -F'\t' '$1 == "moves" { print $2 }' "$OUT/setting.tsv")
-for m in $earlier $MOVES; do
-  case " $held_moves " in *" $m "*) continue ;; esac
-  ! done_already "set_${m%%=*}_${m#*=}" || held_moves+="${held_moves:+ }$m"
-done
-held_wide=""
-earlier=""
-[ ! -f "$OUT/setting.tsv" ] ||
-  earlier=$(awk -F'\t' '$1 == "wide_moves" { print $2 }' "$OUT/setting.tsv")
-for m in $earlier $WIDE_MOVES; do
-  case " $held_wide " in *" $m "*) continue ;; esac
-  [ ! -f "$OUT/fountain_set_${m%%=*}_${m#*=}/fountain.tsv" ] || held_wide+="${held_wide:+ }$m"
-done
-held_tracker=""
-earlier=""
-[ ! -f "$OUT/setting.tsv" ] ||
-  earlier=$(awk -F'\t' '$1 == "tracker_moves" { print $2 }' "$OUT/setting.tsv")
-for m in $earlier $TRACKER_MOVES; do
-  case " $held_tracker " in *" $m "*) continue ;; esac
-  ! done_already "tracker_set_${m%%=*}_${m#*=}" || held_tracker+="${held_tracker:+ }$m"
-done
+move_done() { done_already "set_$1"; }
+tracker_done() { done_already "tracker_set_$1"; }
+fountain_done() { [ -f "$OUT/fountain_set_$1/fountain.tsv" ]; }
+held_of() {  # SETTING_KEY DONE_FN MOVES..: those recorded or given whose table exists
+  local key="$1" done_fn="$2" held="" m earlier=""
+  shift 2
+  [ ! -f "$OUT/setting.tsv" ] ||
+    earlier=$(awk -F'\t' -v k="$key" '$1 == k { print $2 }' "$OUT/setting.tsv")
+  for m in $earlier "$@"; do
+    case " $held " in *" $m "*) continue ;; esac
+    ! "$done_fn" "${m%%=*}_${m#*=}" || held+="${held:+ }$m"
+  done
+  echo "$held"
+}
+# shellcheck disable=SC2086  # the move lists split on purpose
+held_moves=$(held_of moves move_done $MOVES)
+# shellcheck disable=SC2086
+held_wide=$(held_of wide_moves fountain_done $WIDE_MOVES)
+# shellcheck disable=SC2086
+held_tracker=$(held_of tracker_moves tracker_done $TRACKER_MOVES)
 printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\nwide_moves\t%s\ntracker_moves\t%s\n' \
   "$SIZE" "$SEEDS" "$held_switches" "$held_moves" "$held_wide" "$held_tracker" \
   >"$OUT/setting.tsv"

@@ -70,8 +70,10 @@ StreamReconstructor::StreamReconstructor(const StreamOptions& options,
   if (options_.use_tracker)
     tracker_ = std::make_unique<SparseTracker>(options_.tracker, nullptr);
   dispatcher_ = std::make_unique<ThreadPool>(1);
-  revision_dispatcher_ =
-      std::make_unique<ThreadPool>(1, ThreadPool::Priority::kBackground);
+  if (options_.reconstruct) {  // a selector revises nothing
+    revision_dispatcher_ =
+        std::make_unique<ThreadPool>(1, ThreadPool::Priority::kBackground);
+  }
   if (options_.reconstruct && options_.num_threads > 1) {
     inner_pool_ = std::make_unique<ThreadPool>(options_.num_threads - 1);
     revision_pool_ = std::make_unique<ThreadPool>(
@@ -504,6 +506,18 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
   }
 }
 
+int StreamReconstructor::NeighborMapsLocked(
+    const StreamResult& result, MemoryDepthWorkspace* workspace) const {
+  int held = 0;
+  for (uint32_t n : result.neighbor_ids) {
+    auto m = maps_.find(n);
+    if (m == maps_.end() || n == result.keyframe_id) continue;
+    workspace->Put(DepthWorkspace::Stage::kRaw, static_cast<int>(n), m->second);
+    ++held;
+  }
+  return held;
+}
+
 void StreamReconstructor::EndRevisionStepLocked(uint32_t id) {
   // Out of revising_ and the next step scheduled under the same lock:
   // WaitIdle never sees a gap between two steps.
@@ -613,12 +627,7 @@ void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
       return;
     }
     result = it->second;
-    for (uint32_t n : result.neighbor_ids) {
-      auto m = maps_.find(n);
-      if (m != maps_.end())
-        workspace.Put(DepthWorkspace::Stage::kRaw, static_cast<int>(n),
-                      m->second);
-    }
+    NeighborMapsLocked(result, &workspace);
     mvs = options_.mvs;
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -810,13 +819,7 @@ void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation,
       result = std::move(it->second);
       held_.erase(it);
       previewing_.insert(result.keyframe_id);
-      for (uint32_t n : result.neighbor_ids) {
-        auto m = maps_.find(n);
-        if (m == maps_.end() || n == result.keyframe_id) continue;
-        workspace.Put(DepthWorkspace::Stage::kRaw, static_cast<int>(n),
-                      m->second);
-        ++maps;
-      }
+      maps = NeighborMapsLocked(result, &workspace);
       mvs = options_.mvs;
     }
     // Consistent with as many neighbours' maps as it asks for, or with all

@@ -189,6 +189,8 @@ struct StreamStats {
   double last_seconds = 0, mean_seconds = 0;  // per depth map
 };
 
+class MemoryDepthWorkspace;  // pipeline/depth_workspace.h
+
 class StreamReconstructor {
  public:
   using ResultCallback = std::function<void(const StreamResult&)>;
@@ -324,6 +326,10 @@ class StreamReconstructor {
   // sets result->depth and its neighbours; returns the neighbour score.
   double MatchKeyframe(const Snapshot& snap, int ref, const MvsOptions& mvs,
                        ThreadPool* pool, StreamResult* result);
+  // Puts the maps held (maps_) of `result`'s neighbours into `workspace`
+  // (keyed by keyframe id, shared, not copied); returns how many.
+  int NeighborMapsLocked(const StreamResult& result,
+                         MemoryDepthWorkspace* workspace) const;
   void ForgetLocked(uint32_t id);           // a keyframe left the store
   void EndRevisionStepLocked(uint32_t id);  // then schedules the next
   void ClearLocked();
