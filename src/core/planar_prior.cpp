@@ -175,6 +175,25 @@ double ShiftFor(const PatchContext& ctx, const Eigen::Vector3d& Xc) {
 
 }  // namespace
 
+void PlaneEvidence::Add(double on_plane, double nearer, double farther) {
+  if (on_plane <= -1 || nearer <= -1 || farther <= -1) return;
+  const double d = on_plane - 0.5 * (nearer + farther);
+  sum_ += on_plane;
+  sum_d_ += d;
+  sum_d2_ += d * d;
+  ++n_;
+}
+
+bool PlaneEvidence::Supports() const {
+  if (n_ < kMinTestSamples) return false;
+  const double mean_d = sum_d_ / n_;
+  const double var = std::max(0.0, sum_d2_ / n_ - mean_d * mean_d);
+  const double se = std::sqrt(var / (n_ - 1));
+  return mean_d > 0 && mean_d > kSigmas * se;
+}
+
+double PlaneEvidence::MeanScore() const { return n_ > 0 ? sum_ / n_ : -1; }
+
 void FillFromPlanarPrior(const PatchContext& context, const MpgcOptions& mpgc,
                          const LocalViewSelectionOptions& local,
                          const std::vector<Seed>& points, const cv::Mat& mask,
@@ -219,28 +238,18 @@ void FillFromPlanarPrior(const PatchContext& context, const MpgcOptions& mpgc,
         const std::vector<cv::Point>& px = pixels[i];
         const double shift = ShiftFor(context, t.X0);
         const size_t stride = std::max<size_t>(1, px.size() / kTestSamples);
-        double sum = 0, sum_d = 0, sum_d2 = 0;
-        int n = 0;
+        PlaneEvidence evidence;
         for (size_t k = stride / 2; k < px.size(); k += stride) {
           const int x = px[k].x, y = px[k].y;
           if (!m.WindowInside(x, y)) continue;
           const double z = PlaneDepthAt(cam, x, y, t.X0, t.n, -1);
           if (!(z > 0)) continue;
-          const double s0 = m.PlaneScore(x, y, z, t.n, 2);
-          const double sn = m.PlaneScore(x, y, z * (1 - shift), t.n, 2);
-          const double sf = m.PlaneScore(x, y, z * (1 + shift), t.n, 2);
-          if (s0 < -1 || sn < -1 || sf < -1) continue;
-          const double d = s0 - 0.5 * (sn + sf);
-          sum += s0;
-          sum_d += d;
-          sum_d2 += d * d;
-          ++n;
+          const double on_plane = m.PlaneScore(x, y, z, t.n, 2);
+          const double nearer = m.PlaneScore(x, y, z * (1 - shift), t.n, 2);
+          const double farther = m.PlaneScore(x, y, z * (1 + shift), t.n, 2);
+          evidence.Add(on_plane, nearer, farther);
         }
-        if (n < kMinTestSamples) return;
-        const double mean_d = sum_d / n;
-        const double var = std::max(0.0, sum_d2 / n - mean_d * mean_d);
-        const double se = std::sqrt(var / (n - 1));
-        if (mean_d > kSigmas * se && mean_d > 0) keep_score[i] = sum / n;
+        if (evidence.Supports()) keep_score[i] = evidence.MeanScore();
       });
 
   for (int i : tested) {

@@ -2,7 +2,8 @@
 // scenes with exact depth: a weakly textured wall under camera noise, where
 // no single window can be matched but the triangles of a few known samples
 // can, and two textured planes at different depths, where triangles that
-// span the depth edge name planes no surface lies on.
+// span the depth edge name planes no surface lies on. And the triangle
+// test's statistic on given scores: pixels without a score are no evidence.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -178,6 +179,46 @@ TEST(PlanarPrior, KeepsNoTriangleAcrossADepthEdge) {
   EXPECT_GT(sb.filled, 0.6 * sb.surface);
   EXPECT_GT(sb.within_1pct, 0.99 * sb.filled)
       << sb.filled - sb.within_1pct << " wrong of " << sb.filled;
+}
+
+TEST(PlanarPrior, PixelsWithoutAScoreAreNoEvidence) {
+  // Eight pixels where the plane beats its shifted copies by 0.1, then
+  // many the matcher could not score (PlaneScore's -1: a window without
+  // texture, or seen by fewer than two views): the verdict and the score
+  // are those of the eight. Counted as zero differences, the unscored
+  // pixels would shrink the mean below three standard errors and pull the
+  // score towards -1.
+  PlaneEvidence e;
+  for (int i = 0; i < 8; ++i)
+    e.Add(0.8, 0.65 + 0.02 * (i % 2), 0.75 - 0.02 * (i % 2));
+  ASSERT_TRUE(e.Supports());
+  for (int i = 0; i < 200; ++i) {
+    e.Add(-1, -1, -1);
+    e.Add(0.8, -1, 0.7);  // a shifted copy without a score
+    e.Add(0.8, 0.7, -1);
+    e.Add(-1, 0.7, 0.7);
+  }
+  EXPECT_EQ(e.samples(), 8);
+  EXPECT_TRUE(e.Supports());
+  EXPECT_NEAR(e.MeanScore(), 0.8, 1e-12);
+}
+
+TEST(PlanarPrior, EvidenceNeedsEnoughPixelsAndAConsistentWin) {
+  PlaneEvidence few;
+  for (int i = 0; i < 7; ++i) few.Add(0.8, 0.7, 0.7);
+  EXPECT_FALSE(few.Supports());  // 7 pixels: too few to tell
+  few.Add(0.8, 0.7, 0.7);
+  EXPECT_TRUE(few.Supports());
+  // The plane wins on half the pixels and loses as much on the others.
+  PlaneEvidence even;
+  for (int i = 0; i < 48; ++i) even.Add(0.7 + (i % 2 ? 0.1 : -0.1), 0.7, 0.7);
+  EXPECT_FALSE(even.Supports());
+  // Wins by 0.05 on average, but spread +-0.5: within the noise.
+  PlaneEvidence noisy;
+  for (int i = 0; i < 48; ++i)
+    noisy.Add(0.55 + (i % 2 ? 0.5 : -0.5) * 0.9, 0.5, 0.5);
+  EXPECT_FALSE(noisy.Supports());
+  EXPECT_EQ(PlaneEvidence().MeanScore(), -1);
 }
 
 TEST(PlanarPrior, LeavesMaskedPixelsEmpty) {

@@ -23,6 +23,30 @@ struct PlanarPriorStats {
   double cpu_seconds = 0;  // CPU time on pool threads (RunParallel)
 };
 
+// The triangle test's statistic (step 3 below) over a triangle's pixels.
+// A pixel where the plane or a shifted copy has no score
+// (PatchMatcher::PlaneScore returns -1: R's window has no texture, or fewer
+// than two views of N see it) is no evidence either way and is not
+// counted.
+class PlaneEvidence {
+ public:
+  // One pixel's scores (mean NCC, in [-1, 1]; -1 = none) of the window on
+  // the plane, and on the plane moved nearer and farther along the rays.
+  void Add(double on_plane, double nearer, double farther);
+  // Pixels counted (those with all three scores).
+  int samples() const { return n_; }
+  // At least 8 pixels counted (kMinTestSamples), and the mean of the paired
+  // differences on_plane - (nearer + farther) / 2 is positive and more
+  // than 3 of its standard errors (kSigmas).
+  bool Supports() const;
+  // The mean score on the plane over the pixels counted; -1 with none.
+  double MeanScore() const;
+
+ private:
+  double sum_ = 0, sum_d_ = 0, sum_d2_ = 0;
+  int n_ = 0;
+};
+
 // The steps, on R's map after region growing:
 // 1. Vertices: the most confident sample of every kVertexCell x kVertexCell
 //    cell of the map; in a cell without one, a sparse point R sees there
@@ -37,10 +61,10 @@ struct PlanarPriorStats {
 //    over N of the window on the plane, and on the same plane moved
 //    nearer and farther along the rays by the depth that shifts the
 //    triangle's centre kShiftPx pixels in the median view of N. Kept when the
-//    plane's mean score beats the better shifted one by kSigmas standard errors
-//    of the paired differences (the plane explains the images better than its
-//    neighbours in depth, for the triangle as a whole, where no single
-//    window could tell).
+//    plane's score beats the mean of the two shifted ones by kSigmas
+//    standard errors of the paired differences (PlaneEvidence: the plane
+//    explains the images better than its neighbours in depth, for the
+//    triangle as a whole, where no single window could tell).
 // 4. The empty pixels inside kept triangles take the plane: depth, its
 //    normal, and the confidence of its mean score.
 // Pixels with a sample are never changed. mask (CV_8U, may be empty):
