@@ -5,8 +5,10 @@
 # (`--ablation.NAME false`, core/ablation.h), then once per move of a
 # numeric option one step away from its default (`--KEY VALUE`), on the same
 # rendered scenes. Writes OUT/default.tsv, OUT/no_NAME.tsv and
-# OUT/set_KEY_VALUE.tsv (run_families.sh's table). bench/make_results.py
-# shows them side by side: a mechanism whose absence, or a value, that is at
+# OUT/set_KEY_VALUE.tsv (run_families.sh's table), and OUT/meta.tsv (the
+# machine and the code). `bench/make_results.py` writes docs/ABLATION.md from
+# them (OUT is then the folder ablation/ of its argument) and shows them
+# side by side: a mechanism whose absence, or a value, that is at
 # least as good on every family, in coverage within 1 % and in estimates off
 # by more than 5 % (for fusion options: the cloud's F-scores), is one the
 # policy deletes or makes the default (after the same result on other
@@ -98,6 +100,26 @@ if [ -f "$OUT/setting.tsv" ]; then  # tables of another setting are not reused
     exit 2
   }
 fi
+# Nor tables of other code: OUT/meta.tsv records the machine and the code
+# (bench/run_meta.sh) of the first table; a later call on other code (src,
+# include, CMakeLists.txt) stops. Its date and load are those of the last
+# call.
+# shellcheck source=run_meta.sh
+source "$ROOT/bench/run_meta.sh"
+CODE_NOW=$(run_meta_code "$ROOT")
+if [ -f "$OUT/meta.tsv" ]; then
+  code_was=$(awk -F'\t' '$1 == "code" { print $2 }' "$OUT/meta.tsv")
+  code_now=$(awk -F'\t' '$1 == "code" { print $2 }' <<<"$CODE_NOW")
+  [ "$code_was" = "$code_now" ] && [[ "$code_now" != *+changes ]] || {
+    echo "run_ablation.sh: $OUT holds tables of other code ($code_was, now $code_now); use another --out" >&2
+    exit 2
+  }
+  META_HEAD=$(awk -F'\t' '$1 != "date" && $1 != "load"' "$OUT/meta.tsv")
+else
+  META_HEAD=$(printf 'key\tvalue\n'; run_meta_machine; printf '%s\n' "$CODE_NOW")
+fi
+printf '%s\n' "$META_HEAD" >"$OUT/meta.tsv"
+run_meta_now >>"$OUT/meta.tsv"
 done_already() {  # the table exists with its family means
   [ -f "$OUT/$1.tsv" ] && grep -q $'\tMEAN\t' "$OUT/$1.tsv"
 }
@@ -192,4 +214,5 @@ held_tracker=$(held_of tracker_moves tracker_done $TRACKER_MOVES)
 printf 'key\tvalue\nsize\t%s\nseeds\t%s\nswitches\t%s\nmoves\t%s\nwide_moves\t%s\ntracker_moves\t%s\n' \
   "$SIZE" "$SEEDS" "$held_switches" "$held_moves" "$held_wide" "$held_tracker" \
   >"$OUT/setting.tsv"
+{ printf '%s\n' "$META_HEAD"; run_meta_now; } >"$OUT/meta.tsv"
 echo "run_ablation.sh: tables in $OUT" >&2

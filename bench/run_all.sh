@@ -72,6 +72,8 @@ for s in ${SKIP//,/ }; do
   esac
 done
 skipped() { [[ ",$SKIP," == *",$1,"* ]]; }
+# shellcheck source=run_meta.sh
+source "$ROOT/bench/run_meta.sh"
 [ "$BUILD" = 0 ] || bash "$ROOT/scripts/install_deps.sh" --no-ros --tests --bench
 for tool in /usr/bin/time bc; do
   command -v "$tool" >/dev/null || { echo "run_all.sh: needs $tool (apt-get install time bc)" >&2; exit 1; }
@@ -209,17 +211,9 @@ fi
   printf 'key\tvalue\n'
   printf 'command\tbench/run_all.sh%s\n' "$(printf ' %s' "${ARGS[@]+"${ARGS[@]}"}")"
   printf 'mode\t%s\n' "$([ "$QUICK" = 1 ] && echo quick || echo full)"
-  printf 'cpu\t%s\n' "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
-  printf 'cores\t%s\n' "$(nproc)"
-  printf 'memory\t%s\n' "$(awk '/MemTotal/ {printf "%.0f GB", $2 / 1048576}' /proc/meminfo)"
-  printf 'kernel\t%s\n' "$(uname -r)"
-  commit=$(git -C "$ROOT" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
-  [ -z "$(git -C "$ROOT" status --porcelain --untracked-files=no -- src include CMakeLists.txt 2>/dev/null)" ] ||
-    commit="$commit (with uncommitted changes in src/include)"
-  printf 'commit\t%s\n' "$commit"
-  printf 'date\t%s\n' "$(date -u '+%Y-%m-%d %H:%M UTC')"
-  printf 'load\tload average %s at the end (other jobs share the machine; CPU-s stay comparable, wall time would not)\n' \
-    "$(cut -d' ' -f1-3 /proc/loadavg)"
+  run_meta_machine
+  run_meta_code "$ROOT"
+  run_meta_now
   printf 'threads\t%s\n' "$THREADS"
   if [ "$QUICK" = 1 ]; then
     printf 'setting\tquick: temple 320 px, 1 run; fountain 384 px; rendered scenes at %s, seed %s; collections of %s views at %s px\n' \

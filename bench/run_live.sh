@@ -26,12 +26,15 @@
 #
 # Needs the ROS build (scripts/common.sh's BUILD_DIR, default build/). Runs
 # its own roscore on a free port. Prints one row per scene and run and
-# writes OUT/live.tsv; first_s: seconds from an image to its keyframe's
+# writes OUT/live.tsv and OUT/meta.tsv (the command, the code, the date:
+# bench/make_results.py names them when run_all.sh skipped this section and
+# it ran into OUT/live afterwards); first_s: seconds from an image to its keyframe's
 # first depth view (median/max, the bag's clock), revised_after: newer
 # keyframes that got their first depth view before a keyframe's final
 # revision (median/max).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+COMMAND="bench/run_live.sh$(printf ' %q' "$@")"
 OUT="$ROOT/bench/out/live"
 FAMILIES="relief courtyard"
 SEEDS=101
@@ -209,3 +212,10 @@ PY
   done
 done
 column -t -s $'\t' "$TSV"
+# shellcheck source=run_meta.sh
+source "$ROOT/bench/run_meta.sh"
+{
+  printf 'key\tvalue\ncommand\t%s\n' "$COMMAND"
+  run_meta_code "$ROOT"
+  run_meta_now
+} >"$OUT/meta.tsv"
