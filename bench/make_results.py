@@ -404,8 +404,10 @@ def main():
     if "live" in skipped and live_meta:
         skipped.remove("live")
         command_live = re.sub(r" --out \S+| --skip-build", "", live_meta["command"])
+        same = live_meta.get("code") and live_meta.get("code") == meta.get("code")
         md.append(f"| live | `{command_live}` into the same folder afterwards: commit "
-                  f"{live_meta['commit']}, {live_meta['date']}, "
+                  f"{live_meta['commit']} ({'the same' if same else 'other'} code), "
+                  f"{live_meta['date']}, "
                   f"{live_meta['load'].split(' at the end')[0]} at its end |")
     if skipped:
         md.append(f"| not run | {', '.join(skipped)} (skipped) |")

@@ -34,7 +34,10 @@
 # revision (median/max).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-COMMAND="bench/run_live.sh$(printf ' %q' "$@")"
+COMMAND="bench/run_live.sh"
+for arg in "$@"; do
+  case "$arg" in *' '*) COMMAND+=" \"$arg\"" ;; *) COMMAND+=" $arg" ;; esac
+done
 OUT="$ROOT/bench/out/live"
 FAMILIES="relief courtyard"
 SEEDS=101
