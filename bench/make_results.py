@@ -576,7 +576,7 @@ def main():
     md += ["## Mechanisms and thresholds", "",
            "Each mechanism switched off and each threshold moved one step, on the "
            "same families at 320x240: [ABLATION.md](ABLATION.md), written from "
-           "`bench/run_ablation.sh`'s tables by this script on its own schedule "
+           "`bench/run_ablation.sh`'s tables by `bench/make_results.py` on its own schedule "
            "(the ablation takes longer than the rest of the set together); its "
            "header names the code it measured.", ""]
 
