@@ -364,6 +364,11 @@ def write_ablation(out, root):
           "edit by hand (the protocol: [METHODS.md](METHODS.md), \"Benchmark "
           "protocol\"; the product's figures: [RESULTS.md](RESULTS.md)).", ""]
     md += header_rows(meta) + [f"| load | {meta['load']} |", ""]
+    run_all = read_meta(os.path.join(out, "meta.tsv")) or {}
+    if run_all.get("mode") == "quick":
+        md += ["> **Quick setting** (`bench/run_all.sh --quick`: one seed, no "
+               "fountain moves): these tables check that the ablation runs; they "
+               "do not decide a default.", ""]
     md += ["## Mechanisms: each switched off", ""]
     md += mechanism_section(abl_dir, abl_def, setting)
     md += ["## Thresholds: each moved one step", ""]
