@@ -20,6 +20,9 @@
 #             mechanism of the method switched off in turn and each
 #             threshold moved one step (the wide-window ones on fountain-P11,
 #             the tracker's on the same families without sparse points);
+#             written to docs/ABLATION.md, not RESULTS.md; it takes longer
+#             than the rest together, so `--skip ablation` and a separate
+#             `bench/run_ablation.sh --out OUT/ablation` are the usual way;
 #   scale     bench/run_scale.sh: CPU-s per view and peak RSS against the
 #             number of views (100 / 250 / 500);
 #   live      bench/run_live.sh: the depth and fusion nodes on a bag of a
