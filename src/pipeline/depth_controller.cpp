@@ -197,14 +197,17 @@ DepthRunSummary DepthController::FilterViews(const DepthRun& run,
   };
   std::vector<Job> jobs(run.views.size());
   obs.StepBegins(Step::kFilter, total);
-  // One view per task: each reads its raw map and its neighbours' (read
-  // again by every view that needs them: memory stays bounded by threads x
-  // neighbours).
+  // One view per task: each reads its raw map and its neighbours', through
+  // a cache of as many raw maps as the tasks in flight hold at most
+  // (threads x (neighbours + 1)): views in order share most neighbours.
+  const int threads = pool_ ? std::max(1, pool_->size()) : 1;
+  CachedDepthWorkspace raw_maps(workspace,
+                                threads * (options_.global.num_neighbors + 1));
   auto filter_one = [&](int k) {
     Job& job = jobs[k];
     try {
-      const auto raw = workspace->Read(Stage::kRaw, run.views[k]);
-      job.result = Filter(*raw, *workspace);
+      const auto raw = raw_maps.Read(Stage::kRaw, run.views[k]);
+      job.result = Filter(*raw, raw_maps);
     } catch (const Error& e) {
       job.error = e.what();
     }

@@ -32,4 +32,51 @@ void MemoryDepthWorkspace::Put(Stage stage, int key,
   maps_[{stage, key}] = std::move(map);
 }
 
+CachedDepthWorkspace::CachedDepthWorkspace(DepthWorkspace* inner, int capacity)
+    : inner_(inner), capacity_(static_cast<size_t>(capacity)) {
+  Require(inner != nullptr && capacity >= 1,
+          "a cached workspace needs a workspace and a capacity >= 1");
+}
+
+bool CachedDepthWorkspace::Has(Stage stage, int key) const {
+  return inner_->Has(stage, key);
+}
+
+std::shared_ptr<const DepthMap> CachedDepthWorkspace::Read(Stage stage,
+                                                           int key) const {
+  const Key k{stage, key};
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = recent_.begin(); it != recent_.end(); ++it) {
+      if (it->first != k) continue;
+      recent_.splice(recent_.begin(), recent_, it);
+      return recent_.front().second;
+    }
+  }
+  // Read outside the lock: other threads' reads go on meanwhile (two may
+  // read the same map at once; both get the same contents).
+  std::shared_ptr<const DepthMap> map = inner_->Read(stage, key);
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const Entry& e : recent_)
+    if (e.first == k) return e.second;
+  recent_.emplace_front(k, map);
+  if (recent_.size() > capacity_) recent_.pop_back();
+  return map;
+}
+
+long long CachedDepthWorkspace::Samples(Stage stage, int key) const {
+  return inner_->Samples(stage, key);
+}
+
+void CachedDepthWorkspace::Write(Stage stage, int key,
+                                 const ViewResult& result) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    recent_.remove_if([&](const Entry& e) {
+      return e.first == Key{stage, key};
+    });
+  }
+  inner_->Write(stage, key, result);
+}
+
 }  // namespace wild_mvs

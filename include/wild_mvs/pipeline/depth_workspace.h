@@ -9,8 +9,11 @@
 // A map's `neighbors` hold keys of the same workspace.
 #pragma once
 
+#include <list>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <utility>
 
 #include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/geometric_consistency.h"
@@ -56,6 +59,31 @@ class MemoryDepthWorkspace : public DepthWorkspace {
 
  private:
   std::map<std::pair<Stage, int>, std::shared_ptr<const DepthMap>> maps_;
+};
+
+// Another workspace's maps, the last `capacity` read kept in memory (least
+// recently read dropped first): the consistency filter reads each raw map
+// once per view that has it as a neighbour, and views in order share most
+// of their neighbours. Memory stays bounded by `capacity` maps beside the
+// ones in use. Writes go to the other workspace (a cached map of the key
+// and stage written is dropped). Reads are thread-safe.
+class CachedDepthWorkspace : public DepthWorkspace {
+ public:
+  // `inner` must outlive this; capacity >= 1.
+  CachedDepthWorkspace(DepthWorkspace* inner, int capacity);
+
+  bool Has(Stage stage, int key) const override;
+  std::shared_ptr<const DepthMap> Read(Stage stage, int key) const override;
+  long long Samples(Stage stage, int key) const override;
+  void Write(Stage stage, int key, const ViewResult& result) override;
+
+ private:
+  using Key = std::pair<Stage, int>;
+  using Entry = std::pair<Key, std::shared_ptr<const DepthMap>>;
+  DepthWorkspace* inner_;
+  size_t capacity_;
+  mutable std::mutex mutex_;
+  mutable std::list<Entry> recent_;  // most recently read first
 };
 
 }  // namespace wild_mvs
