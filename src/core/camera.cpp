@@ -21,13 +21,6 @@ Eigen::Matrix<double, 3, 4> Camera::P() const {
   return K() * rt;
 }
 
-bool Camera::Project(const Eigen::Vector3d& X, Eigen::Vector2d* px) const {
-  const Eigen::Vector3d xc = WorldToCamera(X);
-  if (!(xc.z() > 0)) return false;
-  *px = ProjectCam(xc);
-  return true;
-}
-
 Eigen::Vector3d Camera::RayCam(const Eigen::Vector2d& px) const {
   return Eigen::Vector3d((px.x() - cx) / fx, (px.y() - cy) / fy, 1.0)
       .normalized();

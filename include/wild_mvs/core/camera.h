@@ -47,7 +47,12 @@ struct Camera {
   }
   // Projects a world point; returns false when it is not in front of the
   // camera (z <= 0). Does not test the image bounds (see InImage).
-  bool Project(const Eigen::Vector3d& X, Eigen::Vector2d* px) const;
+  bool Project(const Eigen::Vector3d& X, Eigen::Vector2d* px) const {
+    const Eigen::Vector3d xc = WorldToCamera(X);
+    if (!(xc.z() > 0)) return false;
+    *px = ProjectCam(xc);
+    return true;
+  }
   // Depth (camera z) of a world point.
   double Depth(const Eigen::Vector3d& X) const {
     return R.row(2).dot(X) + t.z();
