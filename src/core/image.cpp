@@ -142,10 +142,13 @@ std::shared_ptr<const cv::Mat> ImageCache::GetResized(int view, int width,
 }
 
 void ImageCache::Clear() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  lru_.clear();
-  index_.clear();
-  bytes_ = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    lru_.clear();
+    index_.clear();
+    bytes_ = 0;
+  }
+  noise_profiles_.Clear();
 }
 
 size_t ImageCache::bytes() const {

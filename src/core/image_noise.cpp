@@ -86,6 +86,42 @@ double NoiseProfile::MaxSigma() const {
   return *std::max_element(sigma_.begin(), sigma_.end());
 }
 
+NoiseProfileCache::NoiseProfileCache(size_t capacity)
+    : capacity_(std::max<size_t>(capacity, 1)) {}
+
+NoiseProfile NoiseProfileCache::Get(int view, const MatchImage& image) {
+  const Key key{view, image.width, image.height, image.channels};
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = index_.find(key);
+    if (it != index_.end()) {
+      lru_.splice(lru_.begin(), lru_, it->second);
+      return it->second->second;
+    }
+  }
+  const NoiseProfile profile = NoiseProfile::Estimate(image);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (index_.count(key)) return profile;  // another thread estimated it
+  lru_.emplace_front(key, profile);
+  index_[key] = lru_.begin();
+  while (lru_.size() > capacity_) {
+    index_.erase(lru_.back().first);
+    lru_.pop_back();
+  }
+  return profile;
+}
+
+size_t NoiseProfileCache::size() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return lru_.size();
+}
+
+void NoiseProfileCache::Clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  lru_.clear();
+  index_.clear();
+}
+
 double WindowReliability(double ss, double noise_var, int channels, double w1,
                          double w2) {
   if (!(ss > 0) || !(w1 > 0)) return kMinReliability;

@@ -153,7 +153,7 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
     PatchContext ctx;
     ctx.ref_camera = cam;
     ctx.ref_image = ref_img.view;
-    ctx.ref_noise = NoiseProfile::Estimate(ref_img.view);
+    ctx.ref_noise = images.noise_profiles().Get(ref, ref_img.view);
     ctx.window = options.mpgc.window;
     ctx.ablation = options.ablation;
     for (size_t i = 0; i < sel.neighbors.size(); ++i) {
@@ -163,7 +163,8 @@ DepthMap ReconstructView(const Scene& scene, int ref, ImageCache& images,
           options.ablation.color));
       ctx.AddView(sel.neighbors[i], nc, nb_img.back().view,
                   sel.scores[i] > 0 ? sel.scores[i] : 1e-6);
-      ctx.views.back().noise = NoiseProfile::Estimate(nb_img.back().view);
+      ctx.views.back().noise =
+          images.noise_profiles().Get(sel.neighbors[i], nb_img.back().view);
     }
 
     cv::Mat wmask;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "wild_mvs/core/image_noise.h"
@@ -125,6 +126,56 @@ TEST(ImageNoise, ReliabilityUndoesTheAttenuationOfNcc) {
   // Limits: no noise = fully reliable; pure noise = the floor.
   EXPECT_DOUBLE_EQ(WindowReliability(1.0, 0.0, 3, 25, 25), 1.0);
   EXPECT_DOUBLE_EQ(WindowReliability(0.1, 1.0, 3, 25, 25), kMinReliability);
+}
+
+TEST(ImageNoise, CacheEstimatesEachViewSizeAndChannelsOnce) {
+  const auto sigma = [](double m) { return 0.01 + 0.02 * m; };
+  const std::vector<float> a = Textured(160, 120, 0.5, 0.3, sigma, 1);
+  const std::vector<float> b = Textured(
+      160, 120, 0.5, 0.3, [](double) { return 0.05; }, 2);
+  const std::vector<float> small = Textured(80, 60, 0.5, 0.3, sigma, 3);
+  NoiseProfileCache cache(3);
+  // The profile is Estimate's.
+  const NoiseProfile pa = cache.Get(0, View(a, 160, 120));
+  EXPECT_EQ(pa.MaxSigma(),
+            NoiseProfile::Estimate(View(a, 160, 120)).MaxSigma());
+  EXPECT_EQ(cache.size(), 1u);
+  // A view at a size it was estimated at keeps its profile: the cache's
+  // promise is that view 0 at 160 x 120 is always image a.
+  EXPECT_EQ(cache.Get(0, View(b, 160, 120)).MaxSigma(), pa.MaxSigma());
+  EXPECT_EQ(cache.size(), 1u);
+  // Another view, size or channel count is another entry.
+  EXPECT_EQ(cache.Get(1, View(b, 160, 120)).MaxSigma(),
+            NoiseProfile::Estimate(View(b, 160, 120)).MaxSigma());
+  EXPECT_NE(cache.Get(1, View(b, 160, 120)).MaxSigma(), pa.MaxSigma());
+  cache.Get(0, View(small, 80, 60));
+  EXPECT_EQ(cache.size(), 3u);
+  // At capacity the least recently used goes (view 0 at 160 x 120 was
+  // used before view 1 and the small one): it is estimated again.
+  MatchImage grey = View(a, 160, 120);
+  grey.channels = 1;
+  grey.width = 240;  // the same floats read as one grey channel
+  cache.Get(2, grey);
+  EXPECT_EQ(cache.size(), 3u);
+  EXPECT_EQ(cache.Get(0, View(b, 160, 120)).MaxSigma(),
+            NoiseProfile::Estimate(View(b, 160, 120)).MaxSigma());
+  cache.Clear();
+  EXPECT_EQ(cache.size(), 0u);
+  // Four threads asking for the same views at once get Estimate's profiles.
+  std::vector<std::thread> threads;
+  std::vector<double> got(8);
+  for (int k = 0; k < 4; ++k)
+    threads.emplace_back([&, k] {
+      got[2 * k] = cache.Get(0, View(a, 160, 120)).MaxSigma();
+      got[2 * k + 1] = cache.Get(1, View(b, 160, 120)).MaxSigma();
+    });
+  for (std::thread& t : threads) t.join();
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(got[2 * k], pa.MaxSigma());
+    EXPECT_EQ(got[2 * k + 1],
+              NoiseProfile::Estimate(View(b, 160, 120)).MaxSigma());
+  }
+  EXPECT_EQ(cache.size(), 2u);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <string>
 #include <utility>
 
+#include "wild_mvs/core/image_noise.h"
 #include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/scene.h"
 
@@ -66,8 +67,12 @@ class ImageCache {
   // The full-resolution image of `view` from the loader, not cached (for a
   // stage that reads each image once: caching it would only hold memory).
   cv::Mat Load(int view) const { return loader_(view); }
-  // Drops every cached image (images in use elsewhere live on).
+  // Drops every cached image (images in use elsewhere live on) and noise
+  // profile.
   void Clear();
+  // The noise profiles of the images served (image_noise.h), estimated once
+  // per view, size and channels.
+  NoiseProfileCache& noise_profiles() { return noise_profiles_; }
 
   size_t bytes() const;
   size_t peak_bytes() const;
@@ -83,6 +88,7 @@ class ImageCache {
   std::list<std::pair<Key, std::shared_ptr<const cv::Mat>>> lru_;
   std::map<Key, decltype(lru_)::iterator> index_;
   size_t bytes_ = 0, peak_bytes_ = 0;
+  NoiseProfileCache noise_profiles_;
 };
 
 }  // namespace wild_mvs

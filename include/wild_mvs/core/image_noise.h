@@ -15,6 +15,11 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
+#include <list>
+#include <map>
+#include <mutex>
+#include <tuple>
 
 namespace wild_mvs {
 
@@ -49,6 +54,31 @@ class NoiseProfile {
 
  private:
   std::array<float, kBins> sigma_;
+};
+
+// The noise profiles of a run's working images, each estimated once: a
+// view is matched as the reference and again as a neighbour of up to
+// |N| other views, at the same size and with the same profile. Keyed by
+// view, size and channels (the caller's promise: one view at one size and
+// channel count is always the same image, as an ImageCache serves it).
+// Thread-safe; holds at most `capacity` profiles, least recently used
+// dropped first.
+class NoiseProfileCache {
+ public:
+  explicit NoiseProfileCache(size_t capacity = 1024);
+  // The profile of `image`, the matching copy of view `view`: Estimate on
+  // first use (outside the lock; two threads may both estimate it, with
+  // the same result).
+  NoiseProfile Get(int view, const MatchImage& image);
+  size_t size() const;
+  void Clear();
+
+ private:
+  using Key = std::tuple<int, int, int, int>;  // view, width, height, channels
+  size_t capacity_;
+  mutable std::mutex mutex_;
+  std::list<std::pair<Key, NoiseProfile>> lru_;
+  std::map<Key, decltype(lru_)::iterator> index_;
 };
 
 // Reliability r = S / (S + N) of a window with weighted sum of squared
