@@ -57,46 +57,74 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
 
 namespace {
 
+// Where a round trip can come from. Any Y that round-trips to (p, z) lies
+// within `reach` of X (world units): in R's frame, with x, y the normalised
+// coordinates of p, e = r / f the reprojection tolerance r in normalised
+// units and m the relative depth tolerance, Y_R - X_R = (z'x' - zx, z'y' -
+// zy, z' - z) with |z' - z| <= m z and |x' - x| <= e_x, so each coordinate
+// is at most m z (|x| + e_x) + z e_x (likewise y) and m z, and the
+// distance at most their sum. A neighbour's depth differs from X's depth in
+// that neighbour by at most |Y - X| (the depth is a unit projection), so a
+// neighbour pixel whose depth differs by more cannot round-trip: the test
+// skips it without reprojecting (twice the bound, far beyond rounding;
+// the verdicts are exactly those of reprojecting every pixel).
+struct RoundTripTarget {
+  RoundTripTarget(const Camera& rc, const Eigen::Vector2d& p, double z,
+                  const GeometricConsistencyOptions& o)
+      : p(p), z(z), X(rc.Backproject(p, z)) {
+    const double ex = o.max_reprojection_px / rc.fx;
+    const double ey = o.max_reprojection_px / rc.fy;
+    const double x = std::abs((p.x() - rc.cx) / rc.fx);
+    const double y = std::abs((p.y() - rc.cy) / rc.fy);
+    const double m = o.max_relative_depth;
+    reach = z * (m * (1 + x + y + ex + ey) + ex + ey);
+  }
+  Eigen::Vector2d p;  // R's pixel centre
+  double z;           // the sample's depth in R
+  Eigen::Vector3d X;  // the sample's point
+  double reach;       // |Y - X| of any Y that round-trips
+};
+
 // Whether the depth of pixel (qx, qy) of neighbour map `nb`, reprojected
-// into R, lands within the tolerances of (p, z).
+// into R, lands within the tolerances of (p, z). zx: X's depth in nb.
 bool RoundTrips(const Camera& rc, const DepthMap& nb, int qx, int qy,
-                const Eigen::Vector2d& p, double z,
+                const RoundTripTarget& t, double zx,
                 const GeometricConsistencyOptions& o) {
   if (qx < 0 || qy < 0 || qx >= nb.width() || qy >= nb.height()) return false;
   const float zv = nb.depth.at<float>(qy, qx);
   if (!(zv > 0)) return false;
+  if (std::abs(zv - zx) > 2 * t.reach) return false;
   const Eigen::Vector3d Y =
       nb.camera.Backproject(Eigen::Vector2d(qx + 0.5, qy + 0.5), zv);
   Eigen::Vector2d pb;
   if (!rc.Project(Y, &pb)) return false;
   const double zb = rc.Depth(Y);
-  return (pb - p).norm() <= o.max_reprojection_px &&
-         std::abs(zb - z) <= o.max_relative_depth * z;
+  return (pb - t.p).norm() <= o.max_reprojection_px &&
+         std::abs(zb - t.z) <= o.max_relative_depth * t.z;
 }
 
 enum class Verdict { kNone, kConfirms, kViolates };
 
-// What neighbour map `nb` says of depth z at pixel (x, y) of ref: it
-// confirms it when the pixel of nb containing the projection q (or, with
-// search_px > 0, any pixel of nb within search_px of it) round-trips; else
-// it violates it when nb's depth at q lies
-// beyond X by more than the margin.
-Verdict Judge(const Camera& rc, const DepthMap& nb, int x, int y, double z,
+// What neighbour map `nb` says of the sample t.X of ref: it confirms it
+// when the pixel of nb containing its projection q (or, with search_px > 0,
+// any pixel of nb within search_px of it) round-trips; else it violates it
+// when nb's depth at q lies beyond X by more than the margin.
+Verdict Judge(const Camera& rc, const DepthMap& nb, const RoundTripTarget& t,
               const GeometricConsistencyOptions& o) {
-  const Eigen::Vector2d p(x + 0.5, y + 0.5);
-  const Eigen::Vector3d X = rc.Backproject(p, z);
   Eigen::Vector2d q;
-  if (!nb.camera.Project(X, &q)) return Verdict::kNone;
+  if (!nb.camera.Project(t.X, &q)) return Verdict::kNone;
   const int qx = static_cast<int>(std::floor(q.x()));
   const int qy = static_cast<int>(std::floor(q.y()));
-  if (RoundTrips(rc, nb, qx, qy, p, z, o)) return Verdict::kConfirms;
+  const double zx = nb.camera.Depth(t.X);
+  if (RoundTrips(rc, nb, qx, qy, t, zx, o)) return Verdict::kConfirms;
   for (int dy = -o.search_px; dy <= o.search_px; ++dy)
     for (int dx = -o.search_px; dx <= o.search_px; ++dx)
-      if ((dx != 0 || dy != 0) && RoundTrips(rc, nb, qx + dx, qy + dy, p, z, o))
+      if ((dx != 0 || dy != 0) &&
+          RoundTrips(rc, nb, qx + dx, qy + dy, t, zx, o))
         return Verdict::kConfirms;
   if (qx >= 0 && qy >= 0 && qx < nb.width() && qy < nb.height()) {
     const float zv = nb.depth.at<float>(qy, qx);
-    if (zv > 0 && zv > (1 + o.free_space_margin) * nb.camera.Depth(X))
+    if (zv > 0 && zv > (1 + o.free_space_margin) * zx)
       return Verdict::kViolates;
   }
   return Verdict::kNone;
@@ -119,10 +147,12 @@ cv::Mat CountConsistentViews(const DepthMap& ref,
     uint8_t* v = seen_through.ptr<uint8_t>(y);
     for (int x = 0; x < ref.width(); ++x) {
       if (!(d[x] > 0)) continue;
+      const RoundTripTarget target(
+          ref.camera, Eigen::Vector2d(x + 0.5, y + 0.5), d[x], options);
       int n = 0, m = 0;
       for (const DepthMap* nb : neighbors) {
         if (!nb || nb->empty()) continue;
-        const Verdict j = Judge(ref.camera, *nb, x, y, d[x], options);
+        const Verdict j = Judge(ref.camera, *nb, target, options);
         n += j == Verdict::kConfirms;
         m += j == Verdict::kViolates;
       }

@@ -148,6 +148,94 @@ TEST(GeometricConsistency, KeepsTrueDepthsRemovesCorruptedOnes) {
   EXPECT_GT(st.kept, 0.9 * valid);
 }
 
+// The filter's verdicts, reprojecting every candidate pixel as the header
+// defines them (no shortcut): what CountConsistentViews must return.
+void DefinitionCounts(const DepthMap& ref, const std::vector<DepthMap>& nbs,
+                      const GeometricConsistencyOptions& o, cv::Mat* count,
+                      cv::Mat* violations) {
+  *count = cv::Mat::zeros(ref.depth.size(), CV_8U);
+  *violations = cv::Mat::zeros(ref.depth.size(), CV_8U);
+  for (int y = 0; y < ref.height(); ++y)
+    for (int x = 0; x < ref.width(); ++x) {
+      const double z = ref.depth.at<float>(y, x);
+      if (!(z > 0)) continue;
+      const Eigen::Vector2d p(x + 0.5, y + 0.5);
+      const Eigen::Vector3d X = ref.camera.Backproject(p, z);
+      for (const DepthMap& nb : nbs) {
+        Eigen::Vector2d q;
+        if (!nb.camera.Project(X, &q)) continue;
+        const int qx = static_cast<int>(std::floor(q.x()));
+        const int qy = static_cast<int>(std::floor(q.y()));
+        bool confirms = false;
+        for (int dy = -o.search_px; dy <= o.search_px; ++dy)
+          for (int dx = -o.search_px; dx <= o.search_px; ++dx) {
+            const int u = qx + dx, v = qy + dy;
+            if (u < 0 || v < 0 || u >= nb.width() || v >= nb.height()) continue;
+            const float zv = nb.depth.at<float>(v, u);
+            if (!(zv > 0)) continue;
+            const Eigen::Vector3d Y =
+                nb.camera.Backproject(Eigen::Vector2d(u + 0.5, v + 0.5), zv);
+            Eigen::Vector2d pb;
+            if (!ref.camera.Project(Y, &pb)) continue;
+            confirms = confirms || ((pb - p).norm() <= o.max_reprojection_px &&
+                                    std::abs(ref.camera.Depth(Y) - z) <=
+                                        o.max_relative_depth * z);
+          }
+        if (confirms) {
+          ++count->at<uint8_t>(y, x);
+        } else if (qx >= 0 && qy >= 0 && qx < nb.width() && qy < nb.height()) {
+          const float zv = nb.depth.at<float>(qy, qx);
+          if (zv > 0 && zv > (1 + o.free_space_margin) * nb.camera.Depth(X))
+            ++violations->at<uint8_t>(y, x);
+        }
+      }
+    }
+}
+
+TEST(GeometricConsistency, CountsAreTheDefinitionsOnNoisyMaps) {
+  // Every depth of R and of its neighbours (one at half size) off by up to
+  // a few times the tolerances, so that many round trips land near their
+  // limits; the counts and violations must be exactly the definition's
+  // (the filter skips neighbour pixels whose depth is too far from the
+  // sample's to round-trip, without reprojecting them).
+  const SyntheticScene& s = Scene8();
+  std::mt19937 rng(11);
+  std::normal_distribution<float> noise(0.f, 0.02f);
+  auto noisy = [&](DepthMap m) {
+    DepthMap c = Copy(m);
+    for (int y = 0; y < c.height(); ++y)
+      for (int x = 0; x < c.width(); ++x) {
+        float& z = c.depth.at<float>(y, x);
+        if (z > 0) z *= 1.f + noise(rng);
+      }
+    return c;
+  };
+  const DepthMap r = noisy(GtMap(s, 3));
+  std::vector<DepthMap> nbs;
+  for (int v : {1, 2, 4, 5})
+    nbs.push_back(noisy(GtMap(s, v, v == 5 ? 0.5 : 1)));
+  const std::vector<const DepthMap*> ptrs = Pointers(nbs);
+  for (int search : {0, 1, 2})
+    for (double depth_tol : {0.005, 0.01, 0.05})
+      for (double px_tol : {0.5, 1.0, 3.0}) {
+        GeometricConsistencyOptions o;
+        o.search_px = search;
+        o.max_relative_depth = depth_tol;
+        o.max_reprojection_px = px_tol;
+        cv::Mat want_count, want_violations, violations;
+        DefinitionCounts(r, nbs, o, &want_count, &want_violations);
+        const cv::Mat count = CountConsistentViews(r, ptrs, o, &violations);
+        EXPECT_EQ(cv::countNonZero(count != want_count), 0)
+            << "search_px " << search << " depth " << depth_tol << " px "
+            << px_tol;
+        EXPECT_EQ(cv::countNonZero(violations != want_violations), 0);
+        // The noise straddles the tolerances: some samples are confirmed
+        // and some are not.
+        EXPECT_GT(cv::countNonZero(want_count), 0);
+        EXPECT_GT(cv::countNonZero((want_count == 0) & (r.depth > 0)), 0);
+      }
+}
+
 TEST(GeometricConsistency, NoNeighboursKeepsEverything) {
   const SyntheticScene& s = Scene8();
   DepthMap r = GtMap(s, 2);
