@@ -59,15 +59,15 @@ double EpipolarWeight(const Eigen::Vector2d& d1, const Eigen::Vector2d& d2,
 }
 
 int PickNextView(int num_views, const double* global_scores,
-                 const Eigen::Vector2d* directions, const uint8_t* state,
-                 const int* active, int num_active, double max_angle_rad) {
+                 EpipolarWeights& weights, const uint8_t* state,
+                 const int* active, int num_active) {
   int best = -1;
   double best_score = -1;
   for (int v = 0; v < num_views; ++v) {
     if (state[v] != 0) continue;
     double l = global_scores[v];
     for (int a = 0; a < num_active && l > best_score; ++a)
-      l *= EpipolarWeight(directions[v], directions[active[a]], max_angle_rad);
+      l *= weights(v, active[a]);
     if (l > best_score) {
       best_score = l;
       best = v;

@@ -81,9 +81,10 @@ PatchMatcher::PatchMatcher(const PatchContext& context, const MpgcOptions& mpgc,
     Require(v.image.channels == channels_,
             "PatchMatcher: neighbour images must have the reference's ",
             channels_, " channels");
+  static_assert(kMaxNeighbors <= EpipolarWeights::kMaxViews,
+                "every neighbour must fit the epipolar weights");
   Require(ctx_.views.size() <= static_cast<size_t>(kMaxNeighbors),
           "PatchMatcher: too many neighbours");
-  max_angle_rad_ = kMaxEpipolarAngleDeg * M_PI / 180.0;
   for (size_t v = 0; v < ctx_.views.size(); ++v) {
     global_scores_[v] = ctx_.views[v].global_score;
     by_global_score_[v] = static_cast<int>(v);
@@ -196,13 +197,17 @@ void PatchMatcher::InitScales(int slot_index) {
   SlotData& sl = slots_[slot_index];
   for (int c = 0; c < 3; ++c) sl.scale[c] = 1.0f;
   if (!ctx_.ablation.optimize_color_scale) return;
-  for (int c = 0; c < channels_; ++c) {
-    double sv = 0, svv = 0;  // weighted (weight_)
-    for (int i = 0; i < npix_; ++i) {
+  // Weighted (weight_) sums per channel; the channels' sums are independent
+  // chains, run side by side.
+  double sums[3] = {0, 0, 0}, squares[3] = {0, 0, 0};
+  for (int i = 0; i < npix_; ++i)
+    for (int c = 0; c < channels_; ++c) {
       const double p = sl.val[4 * i + c];
-      sv += weight_[i] * p;
-      svv += weight_[i] * p * p;
+      sums[c] += weight_[i] * p;
+      squares[c] += weight_[i] * p * p;
     }
+  for (int c = 0; c < channels_; ++c) {
+    const double sv = sums[c], svv = squares[c];
     if (ctx_.ablation.photometric_offset) {
       // Contrast ratio of the mean-free windows.
       const double saa = ref_saa_c_[c];
@@ -230,8 +235,8 @@ int PatchMatcher::FillActive() {
   const int nv = static_cast<int>(ctx_.views.size());
   int slot = -1;
   return FillActiveSet(
-      local_, ctx_.ablation.local_view_selection, nv, global_scores_, epi_dir_,
-      max_angle_rad_, state_, active_, &num_active_,
+      local_, ctx_.ablation.local_view_selection, nv, global_scores_,
+      epi_weights_, state_, active_, &num_active_,
       [&](int v, double* ncc) {
         slot = FreeSlot();
         PrepareView(v, slot);
@@ -289,34 +294,33 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
       }
     }
   }
-  for (int c = 0; c < channels_; ++c) {
-    const double mean = ref_sum_[c] / npix_;
-    double var_c = 0;
-    for (int i = 0; i < npix_; ++i) {
-      const double d = ref_[4 * i + c] - mean;
-      var_c += d * d;
+  double mean[3], var_c[3] = {0, 0, 0};  // per channel, side by side
+  for (int c = 0; c < channels_; ++c) mean[c] = ref_sum_[c] / npix_;
+  for (int i = 0; i < npix_; ++i)
+    for (int c = 0; c < channels_; ++c) {
+      const double d = ref_[4 * i + c] - mean[c];
+      var_c[c] += d * d;
     }
-    var_total += var_c;
-  }
+  for (int c = 0; c < channels_; ++c) var_total += var_c[c];
   // A textureless reference window cannot be matched (NCC undefined).
   if (var_total < kNccMinVariance * npix_ * channels_ * 100) return false;
   if (ctx_.ablation.bilateral_window) SetBilateralWeights();
+  double sum[3] = {0, 0, 0};
+  for (int i = 0; i < npix_; ++i)
+    for (int c = 0; c < channels_; ++c) sum[c] += weight_[i] * ref_[4 * i + c];
   for (int c = 0; c < channels_; ++c) {
-    double sum = 0;
-    for (int i = 0; i < npix_; ++i) sum += weight_[i] * ref_[4 * i + c];
-    const double mean = sum / weight_sum_;
-    ref_wmean_[c] = mean;
-    double saa_c = 0;
-    for (int i = 0; i < npix_; ++i) {
-      const double d = ref_[4 * i + c] - mean;
+    ref_wmean_[c] = sum[c] / weight_sum_;
+    ref_saa_c_[c] = 0;
+  }
+  for (int i = 0; i < npix_; ++i)
+    for (int c = 0; c < channels_; ++c) {
+      const double d = ref_[4 * i + c] - ref_wmean_[c];
       const float df = static_cast<float>(d);
       const double wdf = weight_[i] * df;
       ref_centered_[4 * i + c] = static_cast<float>(wdf);
-      saa_c += wdf * df;
+      ref_saa_c_[c] += wdf * df;
     }
-    ref_saa_c_[c] = saa_c;
-    ref_saa_ += saa_c;
-  }
+  for (int c = 0; c < channels_; ++c) ref_saa_ += ref_saa_c_[c];
   Eigen::Vector3d n = normal;
   if (!ctx_.ablation.optimize_normal || !(n.norm() > 0.5))
     n = Eigen::Vector3d(0, 0, -1);
@@ -329,6 +333,7 @@ bool PatchMatcher::SetupPixel(int s, int t, double depth,
     state_[k] =
         (!ctx_.ablation.local_view_selection && k >= local_.num_active) ? 2 : 0;
   }
+  epi_weights_.Reset(epi_dir_, nv);
   num_active_ = 0;
   for (SlotData& sl : slots_) sl.fresh = false;
   return true;
@@ -608,10 +613,12 @@ double PatchMatcher::MeanPairwiseNcc(double w2, double* reliability) const {
     const float* v = sl.val;
     ss[a] = 0;
     double brightness = 0;
+    double mean[3] = {0, 0, 0};  // per channel, side by side
+    for (int i = 0; i < npix_; ++i)
+      for (int ch = 0; ch < channels_; ++ch)
+        mean[ch] += weight_[i] * v[4 * i + ch];
     for (int ch = 0; ch < channels_; ++ch) {
-      double m = 0;
-      for (int i = 0; i < npix_; ++i) m += weight_[i] * v[4 * i + ch];
-      m /= weight_sum_;
+      const double m = mean[ch] / weight_sum_;
       brightness += m;
       for (int i = 0; i < npix_; ++i) {
         const float d = static_cast<float>(v[4 * i + ch] - m);

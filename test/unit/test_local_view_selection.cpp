@@ -39,24 +39,42 @@ TEST(MvsLocalViewSelection, SpreadsEpipolarDirections) {
   int active[3];
   int na = 0;
   const double gmax = 10 * kDeg;
-  int v = PickNextView(3, scores, dirs, state, active, na, gmax);
+  EpipolarWeights weights(gmax);
+  weights.Reset(dirs, 3);
+  int v = PickNextView(3, scores, weights, state, active, na);
   EXPECT_EQ(v, 0);
   state[v] = 1;
   active[na++] = v;
-  v = PickNextView(3, scores, dirs, state, active, na, gmax);
+  v = PickNextView(3, scores, weights, state, active, na);
   EXPECT_EQ(v, 2);  // the vertical one before the collinear one
   state[v] = 1;
   active[na++] = v;
-  v = PickNextView(3, scores, dirs, state, active, na, gmax);
+  v = PickNextView(3, scores, weights, state, active, na);
   EXPECT_EQ(v, 1);
   state[v] = 1;
   active[na++] = v;
-  EXPECT_EQ(PickNextView(3, scores, dirs, state, active, na, gmax), -1);
+  EXPECT_EQ(PickNextView(3, scores, weights, state, active, na), -1);
   // Rejected views are never picked again.
   uint8_t rejected[3] = {2, 0, 0};
-  EXPECT_EQ(PickNextView(3, scores, dirs, rejected, active, 0, gmax), 1);
+  EXPECT_EQ(PickNextView(3, scores, weights, rejected, active, 0), 1);
 
   EXPECT_NEAR(EpipolarWeight(dirs[0], dirs[1], gmax), 0.0, 1e-6);
+  // The cached weights are EpipolarWeight's, either way round, before and
+  // after a new pixel's directions.
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      EXPECT_EQ(weights(a, b), EpipolarWeight(dirs[a], dirs[b], gmax));
+      EXPECT_EQ(weights(b, a), weights(a, b));
+    }
+  const double angles[3] = {0.3, 0.3 + 4 * kDeg, 0.3 + 30 * kDeg};
+  Eigen::Vector2d turned[3];
+  for (int i = 0; i < 3; ++i)
+    turned[i] = Eigen::Vector2d(std::cos(angles[i]), std::sin(angles[i]));
+  weights.Reset(turned, 3);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      EXPECT_EQ(weights(a, b), EpipolarWeight(turned[a], turned[b], gmax));
+  EXPECT_NEAR(weights(0, 1), 0.4, 1e-6);
   EXPECT_NEAR(EpipolarWeight(dirs[0], dirs[2], gmax), 1.0, 1e-9);
   const Eigen::Vector2d d5(std::cos(5 * kDeg), std::sin(5 * kDeg));
   EXPECT_NEAR(EpipolarWeight(Eigen::Vector2d(1, 0), d5, gmax), 0.5, 1e-6);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 
 #include "wild_mvs/core/option_registry.h"
@@ -34,13 +35,45 @@ Eigen::Vector2d EpipolarDirection(const Eigen::Vector3d& epipole, double x,
 double EpipolarWeight(const Eigen::Vector2d& d1, const Eigen::Vector2d& d2,
                       double max_angle_rad);
 
+// The epipolar weights w_e between the candidate views at one pixel. A
+// pixel's active set is filled, thinned and refilled many times while it
+// is matched, so each pair's weight is computed once (the same value as
+// EpipolarWeight).
+class EpipolarWeights {
+ public:
+  static constexpr int kMaxViews = 32;  // candidates per pixel
+  explicit EpipolarWeights(double max_angle_rad)
+      : max_angle_rad_(max_angle_rad) {}
+  // Starts a pixel with the epipolar directions of its num_views
+  // (<= kMaxViews) candidates (kept by the caller until the next Reset).
+  void Reset(const Eigen::Vector2d* directions, int num_views) {
+    directions_ = directions;
+    for (int v = 0; v < num_views; ++v)
+      for (int w = 0; w < num_views; ++w) weight_[v * kMaxViews + w] = -1;
+  }
+  // w_e of candidates v and w.
+  double operator()(int v, int w) {
+    double& out = weight_[v * kMaxViews + w];
+    if (out < 0) {
+      out = EpipolarWeight(directions_[v], directions_[w], max_angle_rad_);
+      weight_[w * kMaxViews + v] = out;
+    }
+    return out;
+  }
+
+ private:
+  double max_angle_rad_;
+  const Eigen::Vector2d* directions_ = nullptr;
+  std::array<double, kMaxViews * kMaxViews> weight_;  // < 0: not computed
+};
+
 // Picks the next view to try: the view not yet active or rejected
 // (state[i] == 0) with the highest l_R(V) = g_R(V) * prod over active V' of
 // w_e(V, V'). active lists indices into the candidate arrays. Returns -1
 // when none is left.
 int PickNextView(int num_views, const double* global_scores,
-                 const Eigen::Vector2d* directions, const uint8_t* state,
-                 const int* active, int num_active, double max_angle_rad);
+                 EpipolarWeights& weights, const uint8_t* state,
+                 const int* active, int num_active);
 
 // The admission test: a candidate whose patch NCC with R is below min_ncc
 // does not enter A. Without local view selection (select = false, the
@@ -67,13 +100,13 @@ constexpr uint8_t kCandidateUntried = 0, kCandidateActive = 1,
 template <typename Sample, typename Enter, typename Refuse>
 int FillActiveSet(const LocalViewSelectionOptions& options, bool select,
                   int num_views, const double* global_scores,
-                  const Eigen::Vector2d* directions, double max_angle_rad,
-                  uint8_t* state, int* active, int* num_active, Sample&& sample,
-                  Enter&& enter, Refuse&& refuse) {
+                  EpipolarWeights& weights, uint8_t* state, int* active,
+                  int* num_active, Sample&& sample, Enter&& enter,
+                  Refuse&& refuse) {
   int entered = 0;
   while (*num_active < options.num_active) {
-    const int v = PickNextView(num_views, global_scores, directions, state,
-                               active, *num_active, max_angle_rad);
+    const int v = PickNextView(num_views, global_scores, weights, state, active,
+                               *num_active);
     if (v < 0) break;
     double ncc = 0;
     if (!sample(v, &ncc) || !AdmitsView(options, select, ncc)) {

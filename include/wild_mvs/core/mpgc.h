@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -188,7 +189,7 @@ class PatchMatcher {
   MpgcSchedule schedule_;
   int n_ = 5, half_ = 2, npix_ = 25, channels_ = 3;
   int step_ = 1, reach_ = 2;  // sample spacing; half_ * step_ (pixels)
-  double max_angle_rad_ = 0;
+  EpipolarWeights epi_weights_{kMaxEpipolarAngleDeg * M_PI / 180.0};
   // Current pixel and window surface (h along the ray, per-pixel offsets).
   int s_ = 0, t_ = 0;
   double h_ = 0, hs_ = 0, ht_ = 0;
