@@ -197,12 +197,13 @@ DepthRunSummary DepthController::FilterViews(const DepthRun& run,
   };
   std::vector<Job> jobs(run.views.size());
   obs.StepBegins(Step::kFilter, total);
-  // One view per task: each reads its raw map and its neighbours', through
-  // a cache of as many raw maps as the tasks in flight hold at most
-  // (threads x (neighbours + 1)): views in order share most neighbours.
-  const int threads = pool_ ? std::max(1, pool_->size()) : 1;
+  // One view per task, as many tasks at once as threads: each reads its raw
+  // map and its neighbours', through a cache of as many raw maps as the
+  // tasks in flight hold at most (chunk x (neighbours + 1)): views in order
+  // share most neighbours.
+  const int chunk = pool_ ? std::max(1, pool_->size()) : 1;
   CachedDepthWorkspace raw_maps(workspace,
-                                threads * (options_.global.num_neighbors + 1));
+                                chunk * (options_.global.num_neighbors + 1));
   auto filter_one = [&](int k) {
     Job& job = jobs[k];
     try {
@@ -212,7 +213,6 @@ DepthRunSummary DepthController::FilterViews(const DepthRun& run,
       job.error = e.what();
     }
   };
-  const int chunk = pool_ ? std::max(1, pool_->size()) : 1;
   for (int k0 = 0; k0 < total; k0 += chunk) {
     const int n = std::min(chunk, total - k0);
     if (pool_ && n > 1) {
