@@ -33,7 +33,8 @@ constexpr int kWindowPixels = (kMaxWindowPixels + 7) / 8 * 8;
 constexpr int kWindowFloats = (4 * kMaxWindowPixels + 15) / 16 * 16;
 
 // The window's rays mapped into a view, structure of arrays; entries from
-// npix to kWindowPixels repeat pixel 0 (so padded lanes stay valid).
+// npix to npix rounded up to 8 (the widest double vector the kernels read)
+// repeat pixel 0, so padded lanes stay valid.
 struct WindowRays {
   alignas(64) double ax[kWindowPixels];
   alignas(64) double ay[kWindowPixels];
