@@ -150,8 +150,7 @@ bool PatchMatcher::PrepareView(int v, int slot_index) {
       r.az[idx] = (row.z() + i * cu.z()) * w;
     }
   }
-  const int padded = (npix_ + 7) / 8 * 8;  // WindowRays
-  for (int k = npix_; k < padded; ++k) {
+  for (int k = npix_; k < mpgc_kernels::PaddedPixels(npix_); ++k) {
     r.ax[k] = r.ax[0];
     r.ay[k] = r.ay[0];
     r.az[k] = r.az[0];

@@ -27,14 +27,19 @@
 namespace wild_mvs {
 namespace mpgc_kernels {
 
-// Pixels of the largest window rounded up to 8 (double vectors of AVX-512).
-constexpr int kWindowPixels = (kMaxWindowPixels + 7) / 8 * 8;
+// Doubles in the widest vector the kernels use (AVX-512).
+constexpr int kMaxDoubleLanes = 8;
+// npix window pixels rounded up to whole vectors of kMaxDoubleLanes.
+constexpr int PaddedPixels(int npix) {
+  return (npix + kMaxDoubleLanes - 1) / kMaxDoubleLanes * kMaxDoubleLanes;
+}
+// Pixels of the largest window, padded.
+constexpr int kWindowPixels = PaddedPixels(kMaxWindowPixels);
 // Floats of a window buffer: 4 per pixel, a multiple of 16 (AVX-512).
 constexpr int kWindowFloats = (4 * kMaxWindowPixels + 15) / 16 * 16;
 
 // The window's rays mapped into a view, structure of arrays; entries from
-// npix to npix rounded up to 8 (the widest double vector the kernels read)
-// repeat pixel 0, so padded lanes stay valid.
+// npix to PaddedPixels(npix) repeat pixel 0, so padded lanes stay valid.
 struct WindowRays {
   alignas(64) double ax[kWindowPixels];
   alignas(64) double ay[kWindowPixels];
