@@ -178,6 +178,7 @@ bool PatchMatcher::SampleSlot(int slot_index, bool with_gradient) {
   a.h = h_;
   a.hs = hs_;
   a.ht = ht_;
+  sl.sums_kind = SlotData::Sums::kNone;
   return mpgc_kernels::SampleWindow(a, sl.val,
                                     with_gradient ? sl.dval : nullptr);
 }
@@ -188,6 +189,19 @@ double PatchMatcher::SlotNcc(int slot_index) const {
   double sbb = 0, sab = 0;
   mpgc_kernels::NccSums(ref_centered_, slots_[slot_index].val, mask_, npix_,
                         &sbb, &sab);
+  const double m = weight_sum_ * channels_;
+  if (ref_saa_ < kNccMinVariance * m || sbb < kNccMinVariance * m) return -1;
+  return sab / std::sqrt(ref_saa_ * sbb);
+}
+
+double PatchMatcher::SlotNccAndSums(int slot_index, bool depth_only) {
+  SlotData& sl = slots_[slot_index];
+  double sbb = 0, sab = 0;
+  mpgc_kernels::NormalAndNccSums(
+      ref_, ref_centered_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_, npix_,
+      ctx_.ablation.photometric_offset, depth_only, sl.sums, &sbb, &sab);
+  sl.sums_kind =
+      depth_only ? SlotData::Sums::kDepthOnly : SlotData::Sums::kFull;
   const double m = weight_sum_ * channels_;
   if (ref_saa_ < kNccMinVariance * m || sbb < kNccMinVariance * m) return -1;
   return sab / std::sqrt(ref_saa_ * sbb);
@@ -417,7 +431,7 @@ int PatchMatcher::SampleActive(int first) {
   return left;
 }
 
-int PatchMatcher::TestActive(int it, bool* stable) {
+int PatchMatcher::TestActive(int it, const Update& next, bool* stable) {
   const bool baseline = it == schedule_.settle_iterations;
   const bool oscillation_check = schedule_.oscillation_iteration > 0 &&
                                  it == schedule_.oscillation_iteration;
@@ -426,7 +440,7 @@ int PatchMatcher::TestActive(int it, bool* stable) {
   for (int a = 0; a < num_active_;) {
     SlotData& sl = slots_[active_slot_[a]];
     sl.prev_ncc = baseline ? std::numeric_limits<double>::quiet_NaN() : sl.ncc;
-    sl.ncc = SlotNcc(active_slot_[a]);
+    sl.ncc = SlotNccAndSums(active_slot_[a], next.depth_only());
     const bool moved = !(std::abs(sl.ncc - sl.prev_ncc) <=
                          schedule_.convergence_eps);  // NaN (new view) = moved
     if (baseline) Note(it, MatchTrace::Kind::kBaseline, active_[a]);
@@ -455,16 +469,32 @@ int PatchMatcher::RefillActive() {
   return entered - SampleActive(first_new);
 }
 
+PatchMatcher::Update PatchMatcher::NextUpdate(int it, bool changed) const {
+  const bool full = changed || (it + 1) % schedule_.full_update_interval == 0;
+  return Update{full && ctx_.ablation.optimize_normal,
+                full && ctx_.ablation.optimize_color_scale};
+}
+
+const mpgc_kernels::ChannelSums* PatchMatcher::UpdateSums(int slot_index,
+                                                          bool depth_only) {
+  SlotData& sl = slots_[slot_index];
+  const SlotData::Sums kind =
+      depth_only ? SlotData::Sums::kDepthOnly : SlotData::Sums::kFull;
+  if (sl.sums_kind != kind)
+    mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
+                             npix_, ctx_.ablation.photometric_offset,
+                             depth_only, sl.sums);
+  sl.sums_kind = SlotData::Sums::kNone;  // the update moves patch and scales
+  return sl.sums;
+}
+
 // Depth only, normal and colour scales fixed: one unknown dh,
 // H = sum q^2, g = sum q e with q = c dI/dh and e = I_R - c I_V.
 bool PatchMatcher::DepthStep() {
   double q2 = 0, qe = 0;
   for (int a = 0; a < num_active_; ++a) {
-    const SlotData& sl = slots_[active_slot_[a]];
-    mpgc_kernels::ChannelSums cs[4];
-    mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
-                             npix_, ctx_.ablation.photometric_offset,
-                             /*depth_only=*/true, cs);
+    const mpgc_kernels::ChannelSums* cs =
+        UpdateSums(active_slot_[a], /*depth_only=*/true);
     for (int c = 0; c < channels_; ++c) {
       q2 += cs[c].h[0];
       qe += cs[c].g[0];
@@ -486,14 +516,11 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
   double sii[kMaxActive][3], sie[kMaxActive][3];
   Eigen::Vector3d sij[kMaxActive][3];
   for (int a = 0; a < num_active_; ++a) {
-    const SlotData& sl = slots_[active_slot_[a]];
     // With the photometric offset (I_R = c I_V + b) the offset b per view
     // and channel is eliminated at its optimum: every term is taken about
     // its window mean (the kernel's `center`).
-    mpgc_kernels::ChannelSums cs[4];
-    mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
-                             npix_, ctx_.ablation.photometric_offset,
-                             /*depth_only=*/false, cs);
+    const mpgc_kernels::ChannelSums* cs =
+        UpdateSums(active_slot_[a], /*depth_only=*/false);
     for (int c = 0; c < channels_; ++c) {
       const double* h = cs[c].h;
       H(0, 0) += h[0];
@@ -684,7 +711,8 @@ bool PatchMatcher::Match(int s, int t, double depth,
     const int left = SampleActive(0);
     int dropped = 0;
     bool stable = false;
-    if (it >= schedule_.settle_iterations) dropped = TestActive(it, &stable);
+    if (it >= schedule_.settle_iterations)
+      dropped = TestActive(it, NextUpdate(it, changed || left > 0), &stable);
     if (left + dropped == 0 && stable && !changed &&
         num_active_ >= mpgc_.min_active_views) {
       Note(it, MatchTrace::Kind::kConverged, -1);
@@ -699,15 +727,14 @@ bool PatchMatcher::Match(int s, int t, double depth,
       Note(it, MatchTrace::Kind::kFailed, -1);
       return false;
     }
-    const bool full = changed || (it + 1) % schedule_.full_update_interval == 0;
-    const bool fit_normal = full && ctx_.ablation.optimize_normal;
-    const bool fit_scale = full && ctx_.ablation.optimize_color_scale;
+    const Update update = NextUpdate(it, changed);
     Note(it,
-         (fit_normal || fit_scale) ? MatchTrace::Kind::kFullUpdate
-                                   : MatchTrace::Kind::kDepthUpdate,
+         update.depth_only() ? MatchTrace::Kind::kDepthUpdate
+                             : MatchTrace::Kind::kFullUpdate,
          -1);
-    const bool ok = (fit_normal || fit_scale) ? FullStep(fit_normal, fit_scale)
-                                              : DepthStep();
+    const bool ok = update.depth_only()
+                        ? DepthStep()
+                        : FullStep(update.fit_normal, update.fit_scale);
     if (!ok) {
       Note(it, MatchTrace::Kind::kFailed, -1);
       return false;

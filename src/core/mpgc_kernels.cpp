@@ -146,6 +146,20 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
   }
 }
 
+void NormalAndNccSumsImpl(const float* HWY_RESTRICT ref,
+                          const float* HWY_RESTRICT ref_c,
+                          const float* HWY_RESTRICT val,
+                          const float* HWY_RESTRICT dval, const float scale[3],
+                          const float* HWY_RESTRICT mask,
+                          const float* HWY_RESTRICT wi,
+                          const float* HWY_RESTRICT wj, int npix, bool center,
+                          bool depth_only, ChannelSums out[4], double* sbb,
+                          double* sab) {
+  NormalSumsImpl(ref, val, dval, scale, mask, wi, wj, npix, center, depth_only,
+                 out);
+  NccSumsImpl(ref_c, val, mask, npix, sbb, sab);
+}
+
 #else  // vector targets: at least 4 float lanes
 
 // v's 128-bit blocks added up (lane l of the result = the sum of the lanes
@@ -368,22 +382,28 @@ void NccSumsImpl(const float* HWY_RESTRICT ref_c, const float* HWY_RESTRICT val,
   *sab = SumLanes(d, ab);
 }
 
-void NormalSumsImpl(const float* HWY_RESTRICT ref,
-                    const float* HWY_RESTRICT val,
-                    const float* HWY_RESTRICT dval, const float scale[3],
-                    const float* HWY_RESTRICT mask,
-                    const float* HWY_RESTRICT wi, const float* HWY_RESTRICT wj,
-                    int npix, bool center, bool depth_only,
-                    ChannelSums out[4]) {
+// NormalSums; with kNcc also NccSums of the same samples (ref_c, sbb,
+// sab), each of its sums accumulated from the same terms in the same order
+// as NccSumsImpl does, so with the same value.
+template <bool kNcc>
+HWY_INLINE void NormalSumsT(
+    const float* HWY_RESTRICT ref, const float* HWY_RESTRICT val,
+    const float* HWY_RESTRICT dval, const float scale[3],
+    const float* HWY_RESTRICT mask, const float* HWY_RESTRICT wi,
+    const float* HWY_RESTRICT wj, int npix, bool center, bool depth_only,
+    ChannelSums out[4], const float* HWY_RESTRICT ref_c, double* sbb,
+    double* sab) {
   const hn::ScalableTag<float> d;
   const int n = static_cast<int>(hn::Lanes(d));
   const int nf = Floats(d, npix);
   const double sc4[4] = {scale[0], scale[1], scale[2], 0.0};
   const auto sc = Channels(d, sc4);
-  // Pass 1: the window means of q, q i, q j, I and e per channel.
+  // Pass 1: the window means of q, q i, q j, I and e per channel (and the
+  // NCC's mean of I, the same sums as m[3]).
   double m[5][4] = {};
+  double ncc_mean[4] = {};
   if (center && depth_only) {
-    auto sq = hn::Zero(d), se = sq, sw = sq;
+    auto sq = hn::Zero(d), se = sq, sw = sq, sv = sq;
     for (int k = 0; k < nf; k += n) {
       const auto r = hn::Load(d, mask + k);
       const auto w = hn::Mul(r, r);
@@ -391,12 +411,17 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
       const auto q = hn::Mul(sc, hn::Load(d, dval + k));
       sq = hn::MulAdd(w, q, sq);
       se = hn::MulAdd(w, hn::Sub(hn::Load(d, ref + k), hn::Mul(sc, I)), se);
+      if constexpr (kNcc) sv = hn::MulAdd(w, I, sv);
       sw = hn::Add(sw, w);
     }
     FoldChannels(d, sq, m[0]);
     FoldChannels(d, se, m[4]);
     DivideByWeights(d, sw, m[0]);
     DivideByWeights(d, sw, m[4]);
+    if constexpr (kNcc) {
+      FoldChannels(d, sv, ncc_mean);
+      DivideByWeights(d, sw, ncc_mean);
+    }
   } else if (center) {
     auto sq = hn::Zero(d), sqi = sq, sqj = sq, si = sq, se = sq, sw = sq;
     for (int k = 0; k < nf; k += n) {
@@ -418,12 +443,24 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
     FoldChannels(d, si, m[3]);
     FoldChannels(d, se, m[4]);
     for (auto& mk : m) DivideByWeights(d, sw, mk);
+    if constexpr (kNcc)
+      for (int c = 0; c < 4; ++c) ncc_mean[c] = m[3][c];
+  } else if (kNcc) {  // no centring: the NCC's mean alone
+    auto sv = hn::Zero(d), sw = sv;
+    for (int k = 0; k < nf; k += n) {
+      const auto r = hn::Load(d, mask + k);
+      const auto w = hn::Mul(r, r);
+      sv = hn::MulAdd(w, hn::Load(d, val + k), sv);
+      sw = hn::Add(sw, w);
+    }
+    FoldChannels(d, sv, ncc_mean);
+    DivideByWeights(d, sw, ncc_mean);
   }
   const auto mq = Channels(d, m[0]), mqi = Channels(d, m[1]),
              mqj = Channels(d, m[2]), mi = Channels(d, m[3]),
-             me = Channels(d, m[4]);
-  // Pass 2: the centred (or plain) products.
-  auto h00 = hn::Zero(d), g0 = h00;
+             me = Channels(d, m[4]), mv = Channels(d, ncc_mean);
+  // Pass 2: the centred (or plain) products (and the NCC's sums).
+  auto h00 = hn::Zero(d), g0 = h00, bb = h00, ab = h00;
   if (depth_only) {
     for (int k = 0; k < nf; k += n) {
       const auto w = hn::Load(d, mask + k);
@@ -434,6 +471,15 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
       const auto ue = hn::Mul(hn::Sub(e, me), w);
       h00 = hn::MulAdd(u0, u0, h00);
       g0 = hn::MulAdd(u0, ue, g0);
+      if constexpr (kNcc) {
+        const auto cv = hn::Mul(hn::Sub(I, mv), w);
+        bb = hn::MulAdd(cv, cv, bb);
+        ab = hn::MulAdd(hn::Load(d, ref_c + k), I, ab);
+      }
+    }
+    if constexpr (kNcc) {
+      *sbb = SumLanes(d, bb);
+      *sab = SumLanes(d, ab);
     }
     double a[4], b[4];
     FoldChannels(d, h00, a);
@@ -471,6 +517,17 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
     i2 = hn::MulAdd(u2, ui, i2);
     ii = hn::MulAdd(ui, ui, ii);
     ie = hn::MulAdd(ui, ue, ie);
+    if constexpr (kNcc) {
+      if (!center) {  // centred, ui is the NCC's deviation: bb = ii
+        const auto cv = hn::Mul(hn::Sub(I, mv), w);
+        bb = hn::MulAdd(cv, cv, bb);
+      }
+      ab = hn::MulAdd(hn::Load(d, ref_c + k), I, ab);
+    }
+  }
+  if constexpr (kNcc) {
+    *sbb = SumLanes(d, center ? ii : bb);
+    *sab = SumLanes(d, ab);
   }
   double f[14][4];
   FoldChannels(d, h00, f[0]);
@@ -497,6 +554,30 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
   }
 }
 
+void NormalSumsImpl(const float* HWY_RESTRICT ref,
+                    const float* HWY_RESTRICT val,
+                    const float* HWY_RESTRICT dval, const float scale[3],
+                    const float* HWY_RESTRICT mask,
+                    const float* HWY_RESTRICT wi, const float* HWY_RESTRICT wj,
+                    int npix, bool center, bool depth_only,
+                    ChannelSums out[4]) {
+  NormalSumsT<false>(ref, val, dval, scale, mask, wi, wj, npix, center,
+                     depth_only, out, nullptr, nullptr, nullptr);
+}
+
+void NormalAndNccSumsImpl(const float* HWY_RESTRICT ref,
+                          const float* HWY_RESTRICT ref_c,
+                          const float* HWY_RESTRICT val,
+                          const float* HWY_RESTRICT dval, const float scale[3],
+                          const float* HWY_RESTRICT mask,
+                          const float* HWY_RESTRICT wi,
+                          const float* HWY_RESTRICT wj, int npix, bool center,
+                          bool depth_only, ChannelSums out[4], double* sbb,
+                          double* sab) {
+  NormalSumsT<true>(ref, val, dval, scale, mask, wi, wj, npix, center,
+                    depth_only, out, ref_c, sbb, sab);
+}
+
 #endif  // HWY_TARGET == HWY_SCALAR
 
 const char* KernelTargetImpl() { return hwy::TargetName(HWY_TARGET); }
@@ -513,6 +594,7 @@ namespace mpgc_kernels {
 HWY_EXPORT(SampleWindowImpl);
 HWY_EXPORT(NccSumsImpl);
 HWY_EXPORT(NormalSumsImpl);
+HWY_EXPORT(NormalAndNccSumsImpl);
 HWY_EXPORT(KernelTargetImpl);
 
 bool SampleWindow(const SampleArgs& args, float* val, float* dval) {
@@ -530,6 +612,16 @@ void NormalSums(const float* ref, const float* val, const float* dval,
                 ChannelSums out[4]) {
   HWY_DYNAMIC_DISPATCH(NormalSumsImpl)
   (ref, val, dval, scale, mask, wi, wj, npix, center, depth_only, out);
+}
+
+void NormalAndNccSums(const float* ref, const float* ref_c, const float* val,
+                      const float* dval, const float scale[3],
+                      const float* mask, const float* wi, const float* wj,
+                      int npix, bool center, bool depth_only,
+                      ChannelSums out[4], double* sbb, double* sab) {
+  HWY_DYNAMIC_DISPATCH(NormalAndNccSumsImpl)
+  (ref, ref_c, val, dval, scale, mask, wi, wj, npix, center, depth_only, out,
+   sbb, sab);
 }
 
 const char* KernelTarget() { return HWY_DYNAMIC_DISPATCH(KernelTargetImpl)(); }

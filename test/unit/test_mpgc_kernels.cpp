@@ -271,6 +271,53 @@ TEST(MpgcKernels, WeightedSumsAreTheWeightedDefinitions) {
   EXPECT_GT(compared, 30);
 }
 
+// NormalAndNccSums gives exactly (bit for bit) what NormalSums and NccSums
+// give on the same samples, on every target the binary has for this CPU
+// (the scalar fallback included), centred or not, depth only or full,
+// plain or weighted windows: MPGC takes the NCC test's and the next
+// update's sums in one pass and must match the schedule step by step.
+TEST(MpgcKernels, NormalAndNccSumsAreTheTwoKernels) {
+  std::vector<int64_t> targets = VectorTargets();
+  targets.push_back(FallbackTarget());
+  std::mt19937 rng(5);
+  int compared = 0;
+  for (int64_t t : targets) {
+    UseTarget use(t);
+    for (int trial = 0; trial < 80; ++trial) {
+      const int window = 3 + 2 * (trial % 4);
+      const int channels = trial % 5 == 0 ? 1 : 3;
+      const KernelCase kc(&rng, window, channels, /*weighted=*/trial % 3 == 1);
+      const bool center = trial % 2 == 0, depth_only = trial % 4 < 2;
+      KernelOut o;
+      if (!mk::SampleWindow(kc.args, o.val, o.dval)) continue;
+      const float scale[3] = {1.1f, 0.9f, 1.0f};
+      double sbb = 0, sab = 0;
+      mk::ChannelSums two[4], one[4];
+      mk::NccSums(kc.ref_c, o.val, kc.mask, kc.npix, &sbb, &sab);
+      mk::NormalSums(kc.ref, o.val, o.dval, scale, kc.mask, kc.wi, kc.wj,
+                     kc.npix, center, depth_only, two);
+      double fbb = -1, fab = -1;
+      mk::NormalAndNccSums(kc.ref, kc.ref_c, o.val, o.dval, scale, kc.mask,
+                           kc.wi, kc.wj, kc.npix, center, depth_only, one, &fbb,
+                           &fab);
+      ++compared;
+      EXPECT_EQ(fbb, sbb) << hwy::TargetName(t) << " trial " << trial;
+      EXPECT_EQ(fab, sab) << hwy::TargetName(t) << " trial " << trial;
+      for (int c = 0; c < channels; ++c) {
+        const int nh = depth_only ? 1 : 6, ng = depth_only ? 1 : 3;
+        for (int k = 0; k < nh; ++k) EXPECT_EQ(one[c].h[k], two[c].h[k]);
+        for (int k = 0; k < ng; ++k) EXPECT_EQ(one[c].g[k], two[c].g[k]);
+        if (depth_only) continue;
+        for (int k = 0; k < 3; ++k) EXPECT_EQ(one[c].ic[k], two[c].ic[k]);
+        EXPECT_EQ(one[c].ii, two[c].ii);
+        EXPECT_EQ(one[c].ie, two[c].ie);
+      }
+    }
+  }
+  std::printf("compared %d windows on %zu targets\n", compared, targets.size());
+  EXPECT_GT(compared, 50 * static_cast<int>(targets.size()));
+}
+
 // WILD_MVS_SIMD_TARGET (mpgc_kernels::LimitTarget): capping at each target
 // the binary has for this CPU makes the kernels dispatch to exactly it; an
 // unknown name changes nothing.

@@ -149,10 +149,18 @@ class PatchMatcher {
   bool WindowInside(int s, int t) const;
 
  private:
+  // What one update fits (the paper's schedule, Match).
+  struct Update {
+    bool fit_normal = false, fit_scale = false;
+    bool depth_only() const { return !fit_normal && !fit_scale; }
+  };
   bool SetupPixel(int s, int t, double depth, const Eigen::Vector3d& normal);
   bool PrepareView(int v, int slot_index);
   bool SampleSlot(int slot_index, bool with_gradient);
   double SlotNcc(int slot_index) const;
+  // SlotNcc, with the sums of the next update (depth only or full) taken
+  // from the same samples into the slot (SlotData::sums).
+  double SlotNccAndSums(int slot_index, bool depth_only);
   void InitScales(int slot_index);
   int FreeSlot() const;
   int FillActive();
@@ -164,11 +172,21 @@ class PatchMatcher {
   // NCC of every active view after `it` updates: the baseline right after
   // settling, later the kappa test, the one oscillation check and the
   // convergence test. Returns how many views were dropped; *stable = every
-  // NCC changed by at most eps since the previous iteration.
-  int TestActive(int it, bool* stable);
+  // NCC changed by at most eps since the previous iteration. The sums of
+  // the update that comes next (`next`, as far as known before the test)
+  // are taken in the same pass over each window (SlotData::sums).
+  int TestActive(int it, const Update& next, bool* stable);
   // Refills A by local view selection after views left; returns the number
   // that entered (sampled, with derivatives).
   int RefillActive();
+  // Which unknowns the update after `it` updates fits: the normal and
+  // colour scales when `changed` (A changed since the last full update) or
+  // every full_update_interval-th iteration, else the depth alone.
+  Update NextUpdate(int it, bool changed) const;
+  // The least-squares sums (NormalSums) of a slot's samples at its colour
+  // scales for an update of this kind: those TestActive took with the NCC
+  // when they are of the kind, else computed. Either way used up.
+  const mpgc_kernels::ChannelSums* UpdateSums(int slot_index, bool depth_only);
   bool DepthStep();
   bool FullStep(bool fit_normal, bool fit_scale);
   bool MakeResult(int iterations, PatchResult* out) const;
@@ -236,6 +254,10 @@ class PatchMatcher {
     // val and dval hold the samples at the current patch (taken when the
     // view entered A): the next SampleActive skips the slot once.
     bool fresh = false;
+    // NormalSums of val and dval at scale, taken by TestActive for the next
+    // update (depth only or full); none once used or resampled.
+    enum class Sums { kNone, kDepthOnly, kFull } sums_kind = Sums::kNone;
+    mpgc_kernels::ChannelSums sums[4];
   };
   SlotData slots_[kMaxActive + 1];
 };

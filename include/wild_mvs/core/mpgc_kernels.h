@@ -90,6 +90,16 @@ void NormalSums(const float* ref, const float* val, const float* dval,
                 const float* wj, int npix, bool center, bool depth_only,
                 ChannelSums out[4]);
 
+// NormalSums and NccSums(ref_c, val, mask, npix, sbb, sab) of the same
+// samples in one pass over the window, each sum the same value as the two
+// calls give (MPGC's NCC test and the update after it read the same
+// samples).
+void NormalAndNccSums(const float* ref, const float* ref_c, const float* val,
+                      const float* dval, const float scale[3],
+                      const float* mask, const float* wi, const float* wj,
+                      int npix, bool center, bool depth_only,
+                      ChannelSums out[4], double* sbb, double* sab);
+
 // Name of the instruction set the kernels dispatch to (e.g. "AVX3").
 const char* KernelTarget();
 
