@@ -239,57 +239,84 @@ HWY_INLINE hn::Vec<D> PerPixel(D d, const float* v) {
   }
 }
 
+// Where a window's samples fall in the view: per pixel the top-left
+// pixel of its bilinear cell, the fractions inside it and (with the
+// gradient) the pixel offsets per unit of h.
+struct SamplePositions {
+  alignas(64) int32_t x0[kWindowPixels], y0[kWindowPixels];
+  alignas(64) float fx[kWindowPixels], fy[kWindowPixels];
+  alignas(64) float dx[kWindowPixels], dy[kWindowPixels];
+};
+
+// SamplePositions of pixels [k, k + Lanes(dd)) in double precision (as
+// the scalar code does); false when one falls outside the sampling range or
+// behind the camera.
+template <class DD>
+HWY_INLINE bool PositionsAt(DD dd, const SampleArgs& s, int k, bool gradient,
+                            SamplePositions* p) {
+  const hn::Rebind<int32_t, DD> di;
+  const hn::Rebind<float, DD> df;
+  const auto half = hn::Set(dd, 0.5);
+  const WindowRays& r = *s.rays;
+  const auto hh =
+      hn::Add(hn::Add(hn::Set(dd, s.h),
+                      hn::Mul(hn::Load(dd, s.oj + k), hn::Set(dd, s.ht))),
+              hn::Mul(hn::Load(dd, s.oi + k), hn::Set(dd, s.hs)));
+  const auto ax = hn::Load(dd, r.ax + k), ay = hn::Load(dd, r.ay + k),
+             az = hn::Load(dd, r.az + k);
+  const auto q2 = hn::Add(hn::Set(dd, s.b[2]), hn::Mul(hh, az));
+  const auto inv = hn::Div(hn::Set(dd, 1.0), q2);
+  const auto x = hn::Mul(hn::Add(hn::Set(dd, s.b[0]), hn::Mul(hh, ax)), inv);
+  const auto y = hn::Mul(hn::Add(hn::Set(dd, s.b[1]), hn::Mul(hh, ay)), inv);
+  const auto ok = hn::And(hn::And(hn::Gt(q2, hn::Set(dd, 1e-12)),
+                                  hn::And(hn::Ge(x, half), hn::Ge(y, half))),
+                          hn::And(hn::Lt(x, hn::Set(dd, s.width - 0.5)),
+                                  hn::Lt(y, hn::Set(dd, s.height - 0.5))));
+  if (!hn::AllTrue(dd, ok)) return false;
+  const auto fxd = hn::Sub(x, half), fyd = hn::Sub(y, half);
+  const auto x0 = hn::Min(hn::DemoteTo(di, fxd), hn::Set(di, s.width - 2));
+  const auto y0 = hn::Min(hn::DemoteTo(di, fyd), hn::Set(di, s.height - 2));
+  hn::Store(x0, di, p->x0 + k);
+  hn::Store(y0, di, p->y0 + k);
+  hn::Store(hn::DemoteTo(df, hn::Sub(fxd, hn::PromoteTo(dd, x0))), df,
+            p->fx + k);
+  hn::Store(hn::DemoteTo(df, hn::Sub(fyd, hn::PromoteTo(dd, y0))), df,
+            p->fy + k);
+  if (gradient) {
+    hn::Store(hn::DemoteTo(df, hn::Mul(hn::Sub(ax, hn::Mul(x, az)), inv)), df,
+              p->dx + k);
+    hn::Store(hn::DemoteTo(df, hn::Mul(hn::Sub(ay, hn::Mul(y, az)), inv)), df,
+              p->dy + k);
+  }
+  return true;
+}
+
 bool SampleWindowImpl(const SampleArgs& s, float* HWY_RESTRICT val,
                       float* HWY_RESTRICT dval) {
-  // 1. Pixel positions in the view, vectorised over the window's pixels in
-  // double precision (as the scalar code did).
+  // 1. Pixel positions in the view, vectorised over the window's pixels.
+  // Step 2 reads them up to the next multiple of P = half the double lanes,
+  // so a last group of at most that many pixels takes a half vector (a 5 x 5
+  // window: 3 full vectors of 8 and a half one, on AVX-512).
   const hn::ScalableTag<double> dd;
-  const hn::Rebind<int32_t, decltype(dd)> di;
-  const hn::Rebind<float, decltype(dd)> df;
   const int nd = static_cast<int>(hn::Lanes(dd));
-  alignas(64) int32_t x0s[kWindowPixels], y0s[kWindowPixels];
-  alignas(64) float fxs[kWindowPixels], fys[kWindowPixels];
-  alignas(64) float dxs[kWindowPixels], dys[kWindowPixels];
-  const auto h = hn::Set(dd, s.h), hs = hn::Set(dd, s.hs),
-             ht = hn::Set(dd, s.ht);
-  const auto b0 = hn::Set(dd, s.b[0]), b1 = hn::Set(dd, s.b[1]),
-             b2 = hn::Set(dd, s.b[2]);
-  const auto half = hn::Set(dd, 0.5), one = hn::Set(dd, 1.0),
-             eps = hn::Set(dd, 1e-12);
-  const auto xmax = hn::Set(dd, s.width - 0.5),
-             ymax = hn::Set(dd, s.height - 0.5);
-  const auto x0max = hn::Set(di, s.width - 2),
-             y0max = hn::Set(di, s.height - 2);
-  const WindowRays& r = *s.rays;
-  for (int k = 0; k < s.npix; k += nd) {
-    const auto hh = hn::Add(hn::Add(h, hn::Mul(hn::Load(dd, s.oj + k), ht)),
-                            hn::Mul(hn::Load(dd, s.oi + k), hs));
-    const auto ax = hn::Load(dd, r.ax + k), ay = hn::Load(dd, r.ay + k),
-               az = hn::Load(dd, r.az + k);
-    const auto q2 = hn::Add(b2, hn::Mul(hh, az));
-    const auto inv = hn::Div(one, q2);
-    const auto x = hn::Mul(hn::Add(b0, hn::Mul(hh, ax)), inv);
-    const auto y = hn::Mul(hn::Add(b1, hn::Mul(hh, ay)), inv);
-    const auto ok = hn::And(
-        hn::And(hn::Gt(q2, eps), hn::And(hn::Ge(x, half), hn::Ge(y, half))),
-        hn::And(hn::Lt(x, xmax), hn::Lt(y, ymax)));
-    if (!hn::AllTrue(dd, ok)) return false;
-    const auto fxd = hn::Sub(x, half), fyd = hn::Sub(y, half);
-    const auto x0 = hn::Min(hn::DemoteTo(di, fxd), x0max);
-    const auto y0 = hn::Min(hn::DemoteTo(di, fyd), y0max);
-    hn::Store(x0, di, x0s + k);
-    hn::Store(y0, di, y0s + k);
-    hn::Store(hn::DemoteTo(df, hn::Sub(fxd, hn::PromoteTo(dd, x0))), df,
-              fxs + k);
-    hn::Store(hn::DemoteTo(df, hn::Sub(fyd, hn::PromoteTo(dd, y0))), df,
-              fys + k);
-    if (dval) {
-      hn::Store(hn::DemoteTo(df, hn::Mul(hn::Sub(ax, hn::Mul(x, az)), inv)), df,
-                dxs + k);
-      hn::Store(hn::DemoteTo(df, hn::Mul(hn::Sub(ay, hn::Mul(y, az)), inv)), df,
-                dys + k);
+  SamplePositions pos;
+  int k = 0;
+  for (; k + nd <= s.npix; k += nd)
+    if (!PositionsAt(dd, s, k, dval != nullptr, &pos)) return false;
+  if (k < s.npix) {
+    bool ok;
+    if constexpr (hn::MaxLanes(dd) >= 4) {
+      ok = s.npix - k <= nd / 2 ? PositionsAt(hn::Half<decltype(dd)>(), s, k,
+                                              dval != nullptr, &pos)
+                                : PositionsAt(dd, s, k, dval != nullptr, &pos);
+    } else {
+      ok = PositionsAt(dd, s, k, dval != nullptr, &pos);
     }
+    if (!ok) return false;
   }
+  const int32_t* x0s = pos.x0;
+  const int32_t* y0s = pos.y0;
+  const float *fxs = pos.fx, *fys = pos.fy, *dxs = pos.dx, *dys = pos.dy;
   // 2. Bilinear interpolation, P = lanes / 4 pixels per vector: each
   // pixel's channels are one 128-bit load straight from the interleaved
   // image (lanes past the channels hold the next pixel's values and are
