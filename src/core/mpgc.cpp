@@ -189,6 +189,10 @@ double PatchMatcher::SlotNcc(int slot_index) const {
   double sbb = 0, sab = 0;
   mpgc_kernels::NccSums(ref_centered_, slots_[slot_index].val, mask_, npix_,
                         &sbb, &sab);
+  return NccOfSums(sbb, sab);
+}
+
+double PatchMatcher::NccOfSums(double sbb, double sab) const {
   const double m = weight_sum_ * channels_;
   if (ref_saa_ < kNccMinVariance * m || sbb < kNccMinVariance * m) return -1;
   return sab / std::sqrt(ref_saa_ * sbb);
@@ -197,14 +201,31 @@ double PatchMatcher::SlotNcc(int slot_index) const {
 double PatchMatcher::SlotNccAndSums(int slot_index, bool depth_only) {
   SlotData& sl = slots_[slot_index];
   double sbb = 0, sab = 0;
-  mpgc_kernels::NormalAndNccSums(
-      ref_, ref_centered_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_, npix_,
-      ctx_.ablation.photometric_offset, depth_only, sl.sums, &sbb, &sab);
+  mpgc_kernels::NormalAndNccSums(KernelInput(sl, depth_only), sl.sums, &sbb,
+                                 &sab);
   sl.sums_kind =
       depth_only ? SlotData::Sums::kDepthOnly : SlotData::Sums::kFull;
-  const double m = weight_sum_ * channels_;
-  if (ref_saa_ < kNccMinVariance * m || sbb < kNccMinVariance * m) return -1;
-  return sab / std::sqrt(ref_saa_ * sbb);
+  return NccOfSums(sbb, sab);
+}
+
+mpgc_kernels::SumsInput PatchMatcher::KernelInput(const SlotData& sl,
+                                                  bool depth_only) const {
+  mpgc_kernels::SumsInput in;
+  in.ref = ref_;
+  in.ref_c = ref_centered_;
+  in.val = sl.val;
+  in.dval = sl.dval;
+  in.scale = sl.scale;
+  in.mask = mask_;
+  in.wi = wi_;
+  in.wj = wj_;
+  in.npix = npix_;
+  // With the photometric offset (I_R = c I_V + b) the offset b per view
+  // and channel is eliminated at its optimum: every term is taken about
+  // its window mean.
+  in.center = ctx_.ablation.photometric_offset;
+  in.depth_only = depth_only;
+  return in;
 }
 
 void PatchMatcher::InitScales(int slot_index) {
@@ -481,9 +502,7 @@ const mpgc_kernels::ChannelSums* PatchMatcher::UpdateSums(int slot_index,
   const SlotData::Sums kind =
       depth_only ? SlotData::Sums::kDepthOnly : SlotData::Sums::kFull;
   if (sl.sums_kind != kind)
-    mpgc_kernels::NormalSums(ref_, sl.val, sl.dval, sl.scale, mask_, wi_, wj_,
-                             npix_, ctx_.ablation.photometric_offset,
-                             depth_only, sl.sums);
+    mpgc_kernels::NormalSums(KernelInput(sl, depth_only), sl.sums);
   sl.sums_kind = SlotData::Sums::kNone;  // the update moves patch and scales
   return sl.sums;
 }
@@ -516,9 +535,6 @@ bool PatchMatcher::FullStep(bool fit_normal, bool fit_scale) {
   double sii[kMaxActive][3], sie[kMaxActive][3];
   Eigen::Vector3d sij[kMaxActive][3];
   for (int a = 0; a < num_active_; ++a) {
-    // With the photometric offset (I_R = c I_V + b) the offset b per view
-    // and channel is eliminated at its optimum: every term is taken about
-    // its window mean (the kernel's `center`).
     const mpgc_kernels::ChannelSums* cs =
         UpdateSums(active_slot_[a], /*depth_only=*/false);
     for (int c = 0; c < channels_; ++c) {

@@ -84,14 +84,16 @@ void NccSumsImpl(const float* HWY_RESTRICT ref_c, const float* HWY_RESTRICT val,
   *sab = ab;
 }
 
-void NormalSumsImpl(const float* HWY_RESTRICT ref,
-                    const float* HWY_RESTRICT val,
-                    const float* HWY_RESTRICT dval, const float scale[3],
-                    const float* HWY_RESTRICT mask,
-                    const float* HWY_RESTRICT wi, const float* HWY_RESTRICT wj,
-                    int npix, bool center, bool depth_only,
-                    ChannelSums out[4]) {
-  const float sc[4] = {scale[0], scale[1], scale[2], 0.0f};
+void NormalSumsImpl(const SumsInput& in, ChannelSums out[4]) {
+  const float* HWY_RESTRICT ref = in.ref;
+  const float* HWY_RESTRICT val = in.val;
+  const float* HWY_RESTRICT dval = in.dval;
+  const float* HWY_RESTRICT mask = in.mask;
+  const float* HWY_RESTRICT wi = in.wi;
+  const float* HWY_RESTRICT wj = in.wj;
+  const int npix = in.npix;
+  const bool center = in.center, depth_only = in.depth_only;
+  const float sc[4] = {in.scale[0], in.scale[1], in.scale[2], 0.0f};
   float m[5][4] = {};
   if (center) {
     float wsum[4] = {0, 0, 0, 0};
@@ -146,18 +148,10 @@ void NormalSumsImpl(const float* HWY_RESTRICT ref,
   }
 }
 
-void NormalAndNccSumsImpl(const float* HWY_RESTRICT ref,
-                          const float* HWY_RESTRICT ref_c,
-                          const float* HWY_RESTRICT val,
-                          const float* HWY_RESTRICT dval, const float scale[3],
-                          const float* HWY_RESTRICT mask,
-                          const float* HWY_RESTRICT wi,
-                          const float* HWY_RESTRICT wj, int npix, bool center,
-                          bool depth_only, ChannelSums out[4], double* sbb,
+void NormalAndNccSumsImpl(const SumsInput& in, ChannelSums out[4], double* sbb,
                           double* sab) {
-  NormalSumsImpl(ref, val, dval, scale, mask, wi, wj, npix, center, depth_only,
-                 out);
-  NccSumsImpl(ref_c, val, mask, npix, sbb, sab);
+  NormalSumsImpl(in, out);
+  NccSumsImpl(in.ref_c, in.val, in.mask, in.npix, sbb, sab);
 }
 
 #else  // vector targets: at least 4 float lanes
@@ -413,13 +407,18 @@ void NccSumsImpl(const float* HWY_RESTRICT ref_c, const float* HWY_RESTRICT val,
 // sab), each of its sums accumulated from the same terms in the same order
 // as NccSumsImpl does, so with the same value.
 template <bool kNcc>
-HWY_INLINE void NormalSumsT(
-    const float* HWY_RESTRICT ref, const float* HWY_RESTRICT val,
-    const float* HWY_RESTRICT dval, const float scale[3],
-    const float* HWY_RESTRICT mask, const float* HWY_RESTRICT wi,
-    const float* HWY_RESTRICT wj, int npix, bool center, bool depth_only,
-    ChannelSums out[4], const float* HWY_RESTRICT ref_c, double* sbb,
-    double* sab) {
+HWY_INLINE void NormalSumsT(const SumsInput& in, ChannelSums out[4],
+                            double* sbb, double* sab) {
+  const float* HWY_RESTRICT ref = in.ref;
+  const float* HWY_RESTRICT ref_c = in.ref_c;
+  const float* HWY_RESTRICT val = in.val;
+  const float* HWY_RESTRICT dval = in.dval;
+  const float* HWY_RESTRICT mask = in.mask;
+  const float* HWY_RESTRICT wi = in.wi;
+  const float* HWY_RESTRICT wj = in.wj;
+  const int npix = in.npix;
+  const bool center = in.center, depth_only = in.depth_only;
+  const float* scale = in.scale;
   const hn::ScalableTag<float> d;
   const int n = static_cast<int>(hn::Lanes(d));
   const int nf = Floats(d, npix);
@@ -581,28 +580,13 @@ HWY_INLINE void NormalSumsT(
   }
 }
 
-void NormalSumsImpl(const float* HWY_RESTRICT ref,
-                    const float* HWY_RESTRICT val,
-                    const float* HWY_RESTRICT dval, const float scale[3],
-                    const float* HWY_RESTRICT mask,
-                    const float* HWY_RESTRICT wi, const float* HWY_RESTRICT wj,
-                    int npix, bool center, bool depth_only,
-                    ChannelSums out[4]) {
-  NormalSumsT<false>(ref, val, dval, scale, mask, wi, wj, npix, center,
-                     depth_only, out, nullptr, nullptr, nullptr);
+void NormalSumsImpl(const SumsInput& in, ChannelSums out[4]) {
+  NormalSumsT<false>(in, out, nullptr, nullptr);
 }
 
-void NormalAndNccSumsImpl(const float* HWY_RESTRICT ref,
-                          const float* HWY_RESTRICT ref_c,
-                          const float* HWY_RESTRICT val,
-                          const float* HWY_RESTRICT dval, const float scale[3],
-                          const float* HWY_RESTRICT mask,
-                          const float* HWY_RESTRICT wi,
-                          const float* HWY_RESTRICT wj, int npix, bool center,
-                          bool depth_only, ChannelSums out[4], double* sbb,
+void NormalAndNccSumsImpl(const SumsInput& in, ChannelSums out[4], double* sbb,
                           double* sab) {
-  NormalSumsT<true>(ref, val, dval, scale, mask, wi, wj, npix, center,
-                    depth_only, out, ref_c, sbb, sab);
+  NormalSumsT<true>(in, out, sbb, sab);
 }
 
 #endif  // HWY_TARGET == HWY_SCALAR
@@ -633,22 +617,13 @@ void NccSums(const float* ref_c, const float* val, const float* mask, int npix,
   HWY_DYNAMIC_DISPATCH(NccSumsImpl)(ref_c, val, mask, npix, sbb, sab);
 }
 
-void NormalSums(const float* ref, const float* val, const float* dval,
-                const float scale[3], const float* mask, const float* wi,
-                const float* wj, int npix, bool center, bool depth_only,
-                ChannelSums out[4]) {
-  HWY_DYNAMIC_DISPATCH(NormalSumsImpl)
-  (ref, val, dval, scale, mask, wi, wj, npix, center, depth_only, out);
+void NormalSums(const SumsInput& in, ChannelSums out[4]) {
+  HWY_DYNAMIC_DISPATCH(NormalSumsImpl)(in, out);
 }
 
-void NormalAndNccSums(const float* ref, const float* ref_c, const float* val,
-                      const float* dval, const float scale[3],
-                      const float* mask, const float* wi, const float* wj,
-                      int npix, bool center, bool depth_only,
-                      ChannelSums out[4], double* sbb, double* sab) {
-  HWY_DYNAMIC_DISPATCH(NormalAndNccSumsImpl)
-  (ref, ref_c, val, dval, scale, mask, wi, wj, npix, center, depth_only, out,
-   sbb, sab);
+void NormalAndNccSums(const SumsInput& in, ChannelSums out[4], double* sbb,
+                      double* sab) {
+  HWY_DYNAMIC_DISPATCH(NormalAndNccSumsImpl)(in, out, sbb, sab);
 }
 
 const char* KernelTarget() { return HWY_DYNAMIC_DISPATCH(KernelTargetImpl)(); }

@@ -138,16 +138,35 @@ struct KernelOut {
   mk::ChannelSums full[4], depth[4];
 };
 
+// The kernels' input for the case's R and the samples in o, colour
+// scales 1.1, 0.9, 1.
+mk::SumsInput SumsOf(const KernelCase& kc, const KernelOut& o, bool center,
+                     bool depth_only) {
+  static const float kScale[3] = {1.1f, 0.9f, 1.0f};
+  mk::SumsInput in;
+  in.ref = kc.ref;
+  in.ref_c = kc.ref_c;
+  in.val = o.val;
+  in.dval = o.dval;
+  in.scale = kScale;
+  in.mask = kc.mask;
+  in.wi = kc.wi;
+  in.wj = kc.wj;
+  in.npix = kc.npix;
+  in.center = center;
+  in.depth_only = depth_only;
+  return in;
+}
+
 KernelOut RunKernels(const KernelCase& kc, bool center) {
   KernelOut o;
   o.inside = mk::SampleWindow(kc.args, o.val, o.dval);
   if (!o.inside) return o;
   mk::NccSums(kc.ref_c, o.val, kc.mask, kc.npix, &o.sbb, &o.sab);
-  const float scale[3] = {1.1f, 0.9f, 1.0f};
-  mk::NormalSums(kc.ref, o.val, o.dval, scale, kc.mask, kc.wi, kc.wj, kc.npix,
-                 center, false, o.full);
-  mk::NormalSums(kc.ref, o.val, o.dval, scale, kc.mask, kc.wi, kc.wj, kc.npix,
-                 center, true, o.depth);
+  mk::SumsInput in = SumsOf(kc, o, center, /*depth_only=*/false);
+  mk::NormalSums(in, o.full);
+  in.depth_only = true;
+  mk::NormalSums(in, o.depth);
   return o;
 }
 
@@ -290,16 +309,13 @@ TEST(MpgcKernels, NormalAndNccSumsAreTheTwoKernels) {
       const bool center = trial % 2 == 0, depth_only = trial % 4 < 2;
       KernelOut o;
       if (!mk::SampleWindow(kc.args, o.val, o.dval)) continue;
-      const float scale[3] = {1.1f, 0.9f, 1.0f};
+      const mk::SumsInput in = SumsOf(kc, o, center, depth_only);
       double sbb = 0, sab = 0;
       mk::ChannelSums two[4], one[4];
       mk::NccSums(kc.ref_c, o.val, kc.mask, kc.npix, &sbb, &sab);
-      mk::NormalSums(kc.ref, o.val, o.dval, scale, kc.mask, kc.wi, kc.wj,
-                     kc.npix, center, depth_only, two);
+      mk::NormalSums(in, two);
       double fbb = -1, fab = -1;
-      mk::NormalAndNccSums(kc.ref, kc.ref_c, o.val, o.dval, scale, kc.mask,
-                           kc.wi, kc.wj, kc.npix, center, depth_only, one, &fbb,
-                           &fab);
+      mk::NormalAndNccSums(in, one, &fbb, &fab);
       ++compared;
       EXPECT_EQ(fbb, sbb) << hwy::TargetName(t) << " trial " << trial;
       EXPECT_EQ(fab, sab) << hwy::TargetName(t) << " trial " << trial;

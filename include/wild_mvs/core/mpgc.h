@@ -161,6 +161,9 @@ class PatchMatcher {
   // SlotNcc, with the sums of the next update (depth only or full) taken
   // from the same samples into the slot (SlotData::sums).
   double SlotNccAndSums(int slot_index, bool depth_only);
+  // The NCC of R's window with a view's from the kernels' sums (-1 when
+  // either window is flat).
+  double NccOfSums(double sbb, double sab) const;
   void InitScales(int slot_index);
   int FreeSlot() const;
   int FillActive();
@@ -187,6 +190,10 @@ class PatchMatcher {
   // scales for an update of this kind: those TestActive took with the NCC
   // when they are of the kind, else computed. Either way used up.
   const mpgc_kernels::ChannelSums* UpdateSums(int slot_index, bool depth_only);
+  struct SlotData;
+  // The kernels' input for a slot's least squares (and NCC).
+  mpgc_kernels::SumsInput KernelInput(const SlotData& sl,
+                                      bool depth_only) const;
   bool DepthStep();
   bool FullStep(bool fit_normal, bool fit_scale);
   bool MakeResult(int iterations, PatchResult* out) const;

@@ -76,7 +76,7 @@ void NccSums(const float* ref_c, const float* val, const float* mask, int npix,
 
 // Sums of the least squares of one view, per channel c (lanes): with
 // q = scale_c * dval, e = ref - scale_c * val and the window offsets
-// (i, j) = (wi, wj) of each pixel, u = (q, q i, q j):
+// (i, j) = (wi, wj) of each pixel, u = (q, q i, q j) (SumsInput below):
 //   h = sum u u^T (upper triangle: 00 01 02 11 12 22), g = sum u e,
 //   ic = sum u val, ii = sum val^2, ie = sum val e;
 // with `center` every term is taken about its window mean (the photometric
@@ -85,20 +85,29 @@ void NccSums(const float* ref_c, const float* val, const float* mask, int npix,
 struct ChannelSums {
   double h[6], g[3], ic[3], ii, ie;
 };
-void NormalSums(const float* ref, const float* val, const float* dval,
-                const float scale[3], const float* mask, const float* wi,
-                const float* wj, int npix, bool center, bool depth_only,
-                ChannelSums out[4]);
+// The windows of one view's least squares (pointers into kWindowFloats
+// buffers in the layout above).
+struct SumsInput {
+  const float* ref = nullptr;    // R's window
+  const float* ref_c = nullptr;  // R's centred window times w (NccSums)
+  const float* val = nullptr;    // the view's samples
+  const float* dval = nullptr;   // their derivative along the ray
+  const float* scale = nullptr;  // the view's colour scale, per channel (3)
+  const float* mask = nullptr;   // root weights
+  const float* wi = nullptr;     // window column offset i per lane
+  const float* wj = nullptr;     // window row offset j per lane
+  int npix = 0;
+  bool center = true;       // every term about its window mean
+  bool depth_only = false;  // only h[0] and g[0]
+};
+void NormalSums(const SumsInput& in, ChannelSums out[4]);
 
-// NormalSums and NccSums(ref_c, val, mask, npix, sbb, sab) of the same
-// samples in one pass over the window, each sum the same value as the two
-// calls give (MPGC's NCC test and the update after it read the same
-// samples).
-void NormalAndNccSums(const float* ref, const float* ref_c, const float* val,
-                      const float* dval, const float scale[3],
-                      const float* mask, const float* wi, const float* wj,
-                      int npix, bool center, bool depth_only,
-                      ChannelSums out[4], double* sbb, double* sab);
+// NormalSums and NccSums(in.ref_c, in.val, in.mask, in.npix, sbb, sab) of
+// the same samples in one pass over the window, each sum the same value as
+// the two calls give (MPGC's NCC test and the update after it read the
+// same samples).
+void NormalAndNccSums(const SumsInput& in, ChannelSums out[4], double* sbb,
+                      double* sab);
 
 // Name of the instruction set the kernels dispatch to (e.g. "AVX3").
 const char* KernelTarget();
