@@ -201,7 +201,7 @@ bool StreamingFusion::HasView(int view) const {
 size_t StreamingFusion::num_points() const { return points_.size(); }
 
 size_t StreamingFusion::bytes() const {
-  return lru_bytes_ + PendingBytes() + CloudBytes();
+  return maps_.cost() + PendingBytes() + CloudBytes();
 }
 
 size_t StreamingFusion::PendingBytes() const {
@@ -229,20 +229,16 @@ size_t StreamingFusion::MapCap() const {
 void StreamingFusion::EvictMaps() {
   // Least recently used first; maps in use elsewhere (use_count > 1: the
   // view being added, the related map being checked) stay.
-  const size_t cap = MapCap();
-  for (auto e = lru_.end(); lru_bytes_ > cap && e != lru_.begin();) {
-    --e;
-    if (e->second.use_count() == 1) {
-      lru_bytes_ -= e->second->bytes();
-      lru_index_.erase(e->first);
-      e = lru_.erase(e);
-    }
-  }
+  maps_.Evict(MapCap(), /*keep=*/0,
+              [](const std::shared_ptr<const Prepared>& p) {
+                return p.use_count() > 1;
+              });
 }
 
 void StreamingFusion::UpdatePeak() {
-  stats_.held_map_bytes = lru_bytes_;
-  stats_.peak_held_map_bytes = std::max(stats_.peak_held_map_bytes, lru_bytes_);
+  stats_.held_map_bytes = maps_.cost();
+  stats_.peak_held_map_bytes =
+      std::max(stats_.peak_held_map_bytes, maps_.cost());
   stats_.peak_bytes = std::max(stats_.peak_bytes, bytes());
   stats_.pending = pending_count_;
   stats_.pending_bytes = PendingBytes();
@@ -369,11 +365,7 @@ std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::Prepare(
 
 std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::GetMap(
     int view, bool required) {
-  auto it = lru_index_.find(view);
-  if (it != lru_index_.end()) {
-    lru_.splice(lru_.begin(), lru_, it->second);
-    return it->second->second;
-  }
+  if (const auto* hit = maps_.Find(view)) return *hit;
   std::shared_ptr<const DepthMap> m = depth_(view);
   if (!m && !required) return nullptr;
   Require(m != nullptr,
@@ -381,9 +373,7 @@ std::shared_ptr<const StreamingFusion::Prepared> StreamingFusion::GetMap(
   ++stats_.map_loads;
   std::shared_ptr<const Prepared> p = Prepare(view, *m);
   m.reset();
-  lru_.emplace_front(view, p);
-  lru_index_[view] = lru_.begin();
-  lru_bytes_ += p->bytes();
+  maps_.Insert(view, p, p->bytes());
   EvictMaps();
   UpdatePeak();
   return p;
@@ -562,9 +552,7 @@ void StreamingFusion::TrimPending() {
 
 void StreamingFusion::Finish() {
   finished_ = true;
-  lru_.clear();
-  lru_index_.clear();
-  lru_bytes_ = 0;
+  maps_.Clear();
   pending_.clear();
   pending_count_ = 0;
   UpdatePeak();

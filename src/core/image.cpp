@@ -97,25 +97,17 @@ ImageCache::ImageCache(Loader loader, double capacity_mb)
 
 std::shared_ptr<const cv::Mat> ImageCache::Lookup(const Key& key) {
   std::lock_guard<std::mutex> lock(mutex_);
-  auto it = index_.find(key);
-  if (it == index_.end()) return nullptr;
-  lru_.splice(lru_.begin(), lru_, it->second);
-  return it->second->second;
+  const auto* hit = images_.Find(key);
+  return hit ? *hit : nullptr;
 }
 
 void ImageCache::Insert(const Key& key, std::shared_ptr<const cv::Mat> img) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (index_.count(key)) return;  // another thread loaded it meanwhile
-  lru_.emplace_front(key, img);
-  index_[key] = lru_.begin();
-  bytes_ += img->total() * img->elemSize();
-  peak_bytes_ = std::max(peak_bytes_, bytes_);
-  while (bytes_ > capacity_bytes_ && lru_.size() > 1) {
-    auto& back = lru_.back();
-    bytes_ -= back.second->total() * back.second->elemSize();
-    index_.erase(back.first);
-    lru_.pop_back();
-  }
+  const size_t bytes = img->total() * img->elemSize();
+  // Present already: another thread loaded it meanwhile.
+  if (!images_.Insert(key, std::move(img), bytes)) return;
+  peak_bytes_ = std::max(peak_bytes_, images_.cost());
+  images_.Evict(capacity_bytes_, /*keep=*/1);  // the newest always stays
 }
 
 std::shared_ptr<const cv::Mat> ImageCache::Get(int view) {
@@ -144,16 +136,14 @@ std::shared_ptr<const cv::Mat> ImageCache::GetResized(int view, int width,
 void ImageCache::Clear() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    lru_.clear();
-    index_.clear();
-    bytes_ = 0;
+    images_.Clear();
   }
   noise_profiles_.Clear();
 }
 
 size_t ImageCache::bytes() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return bytes_;
+  return images_.cost();
 }
 
 size_t ImageCache::peak_bytes() const {

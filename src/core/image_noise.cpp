@@ -93,33 +93,23 @@ NoiseProfile NoiseProfileCache::Get(int view, const MatchImage& image) {
   const Key key{view, image.width, image.height, image.channels};
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    auto it = index_.find(key);
-    if (it != index_.end()) {
-      lru_.splice(lru_.begin(), lru_, it->second);
-      return it->second->second;
-    }
+    if (const NoiseProfile* hit = profiles_.Find(key)) return *hit;
   }
   const NoiseProfile profile = NoiseProfile::Estimate(image);
   std::lock_guard<std::mutex> lock(mutex_);
-  if (index_.count(key)) return profile;  // another thread estimated it
-  lru_.emplace_front(key, profile);
-  index_[key] = lru_.begin();
-  while (lru_.size() > capacity_) {
-    index_.erase(lru_.back().first);
-    lru_.pop_back();
-  }
+  // Present already: another thread estimated it (the same profile).
+  if (profiles_.Insert(key, profile, 1)) profiles_.Evict(capacity_);
   return profile;
 }
 
 size_t NoiseProfileCache::size() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return lru_.size();
+  return profiles_.size();
 }
 
 void NoiseProfileCache::Clear() {
   std::lock_guard<std::mutex> lock(mutex_);
-  lru_.clear();
-  index_.clear();
+  profiles_.Clear();
 }
 
 double WindowReliability(double ss, double noise_var, int channels, double w1,

@@ -47,20 +47,15 @@ std::shared_ptr<const DepthMap> CachedDepthWorkspace::Read(Stage stage,
   const Key k{stage, key};
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (auto it = recent_.begin(); it != recent_.end(); ++it) {
-      if (it->first != k) continue;
-      recent_.splice(recent_.begin(), recent_, it);
-      return recent_.front().second;
-    }
+    if (const auto* hit = recent_.Find(k)) return *hit;
   }
   // Read outside the lock: other threads' reads go on meanwhile (two may
   // read the same map at once; both get the same contents).
   std::shared_ptr<const DepthMap> map = inner_->Read(stage, key);
   std::lock_guard<std::mutex> lock(mutex_);
-  for (const Entry& e : recent_)
-    if (e.first == k) return e.second;
-  recent_.emplace_front(k, map);
-  if (recent_.size() > capacity_) recent_.pop_back();
+  if (const auto* hit = recent_.Find(k)) return *hit;
+  recent_.Insert(k, map, 1);
+  recent_.Evict(capacity_);
   return map;
 }
 
@@ -72,9 +67,7 @@ void CachedDepthWorkspace::Write(Stage stage, int key,
                                  const ViewResult& result) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    recent_.remove_if([&](const Entry& e) {
-      return e.first == Key{stage, key};
-    });
+    recent_.Erase(Key{stage, key});
   }
   inner_->Write(stage, key, result);
 }

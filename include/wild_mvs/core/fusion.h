@@ -61,6 +61,7 @@
 
 #include "wild_mvs/core/block_vector.h"
 #include "wild_mvs/core/depth_map.h"
+#include "wild_mvs/core/lru_cache.h"
 #include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/point_cloud.h"
 #include "wild_mvs/core/thread_pool.h"
@@ -219,10 +220,8 @@ class StreamingFusion {
   // u -> the added views whose neighbours include u, in added order.
   std::unordered_map<int, std::vector<int>> listed_by_;
 
-  // LRU of prepared maps.
-  std::list<std::pair<int, std::shared_ptr<const Prepared>>> lru_;
-  std::unordered_map<int, decltype(lru_)::iterator> lru_index_;
-  size_t lru_bytes_ = 0;
+  // Prepared maps, least recently used dropped first (cost: bytes).
+  LruCache<int, std::shared_ptr<const Prepared>> maps_;
 
   // Pending samples per view, in view-added order (oldest first).
   std::list<std::pair<int, std::vector<Pending>>> pending_;

@@ -9,8 +9,6 @@
 
 #include <cstddef>
 #include <functional>
-#include <list>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
@@ -18,6 +16,7 @@
 #include <utility>
 
 #include "wild_mvs/core/image_noise.h"
+#include "wild_mvs/core/lru_cache.h"
 #include "wild_mvs/core/option_registry.h"
 #include "wild_mvs/core/scene.h"
 
@@ -85,9 +84,8 @@ class ImageCache {
   Loader loader_;
   size_t capacity_bytes_;
   mutable std::mutex mutex_;
-  std::list<std::pair<Key, std::shared_ptr<const cv::Mat>>> lru_;
-  std::map<Key, decltype(lru_)::iterator> index_;
-  size_t bytes_ = 0, peak_bytes_ = 0;
+  LruCache<Key, std::shared_ptr<const cv::Mat>> images_;  // cost: bytes
+  size_t peak_bytes_ = 0;
   NoiseProfileCache noise_profiles_;
 };
 

@@ -16,10 +16,10 @@
 
 #include <array>
 #include <cstddef>
-#include <list>
-#include <map>
 #include <mutex>
 #include <tuple>
+
+#include "wild_mvs/core/lru_cache.h"
 
 namespace wild_mvs {
 
@@ -77,8 +77,7 @@ class NoiseProfileCache {
   using Key = std::tuple<int, int, int, int>;  // view, width, height, channels
   size_t capacity_;
   mutable std::mutex mutex_;
-  std::list<std::pair<Key, NoiseProfile>> lru_;
-  std::map<Key, decltype(lru_)::iterator> index_;
+  LruCache<Key, NoiseProfile> profiles_;  // cost 1 each
 };
 
 // Reliability r = S / (S + N) of a window with weighted sum of squared

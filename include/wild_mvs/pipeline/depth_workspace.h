@@ -9,7 +9,6 @@
 // A map's `neighbors` hold keys of the same workspace.
 #pragma once
 
-#include <list>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -17,6 +16,7 @@
 
 #include "wild_mvs/core/depth_map.h"
 #include "wild_mvs/core/geometric_consistency.h"
+#include "wild_mvs/core/lru_cache.h"
 #include "wild_mvs/core/reconstruct_view.h"
 
 namespace wild_mvs {
@@ -79,11 +79,11 @@ class CachedDepthWorkspace : public DepthWorkspace {
 
  private:
   using Key = std::pair<Stage, int>;
-  using Entry = std::pair<Key, std::shared_ptr<const DepthMap>>;
   DepthWorkspace* inner_;
   size_t capacity_;
   mutable std::mutex mutex_;
-  mutable std::list<Entry> recent_;  // most recently read first
+  // The maps read, cost 1 each.
+  mutable LruCache<Key, std::shared_ptr<const DepthMap>> recent_;
 };
 
 }  // namespace wild_mvs
