@@ -90,6 +90,9 @@ if ! skipped fountain && [ ! -d "$DATASETS/strecha_fountain-P11" ]; then
   echo "run_all.sh: no $DATASETS/strecha_fountain-P11 (set WILD_MVS_DATASETS or --skip fountain)" >&2
   exit 1
 fi
+# The code measured: the tree as the run starts (edits made while it runs
+# are not in its binaries); a tree changed by the end is said too.
+CODE_META="$(run_meta_code "$ROOT")"
 [ -n "$OUT" ] || OUT="$ROOT/bench/out/all-$(date -u +%Y%m%dT%H%M%S)"
 mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)"
@@ -215,7 +218,11 @@ fi
   printf 'command\tbench/run_all.sh%s\n' "$(printf ' %s' "${ARGS[@]+"${ARGS[@]}"}")"
   printf 'mode\t%s\n' "$([ "$QUICK" = 1 ] && echo quick || echo full)"
   run_meta_machine
-  run_meta_code "$ROOT"
+  if [ "$(run_meta_code "$ROOT")" = "$CODE_META" ]; then
+    printf '%s\n' "$CODE_META"
+  else
+    printf '%s\n' "$CODE_META" | sed '/^commit/s/$/ (src or include edited during the run)/'
+  fi
   run_meta_now
   printf 'threads\t%s\n' "$THREADS"
   if [ "$QUICK" = 1 ]; then
