@@ -201,15 +201,16 @@ double PatchMatcher::NccOfSums(double sbb, double sab) const {
 double PatchMatcher::SlotNccAndSums(int slot_index, bool depth_only) {
   SlotData& sl = slots_[slot_index];
   double sbb = 0, sab = 0;
-  mpgc_kernels::NormalAndNccSums(KernelInput(sl, depth_only), sl.sums, &sbb,
-                                 &sab);
+  mpgc_kernels::NormalAndNccSums(KernelInput(slot_index, depth_only), sl.sums,
+                                 &sbb, &sab);
   sl.sums_kind =
       depth_only ? SlotData::Sums::kDepthOnly : SlotData::Sums::kFull;
   return NccOfSums(sbb, sab);
 }
 
-mpgc_kernels::SumsInput PatchMatcher::KernelInput(const SlotData& sl,
+mpgc_kernels::SumsInput PatchMatcher::KernelInput(int slot_index,
                                                   bool depth_only) const {
+  const SlotData& sl = slots_[slot_index];
   mpgc_kernels::SumsInput in;
   in.ref = ref_;
   in.ref_c = ref_centered_;
@@ -502,7 +503,7 @@ const mpgc_kernels::ChannelSums* PatchMatcher::UpdateSums(int slot_index,
   const SlotData::Sums kind =
       depth_only ? SlotData::Sums::kDepthOnly : SlotData::Sums::kFull;
   if (sl.sums_kind != kind)
-    mpgc_kernels::NormalSums(KernelInput(sl, depth_only), sl.sums);
+    mpgc_kernels::NormalSums(KernelInput(slot_index, depth_only), sl.sums);
   sl.sums_kind = SlotData::Sums::kNone;  // the update moves patch and scales
   return sl.sums;
 }

@@ -190,10 +190,8 @@ class PatchMatcher {
   // scales for an update of this kind: those TestActive took with the NCC
   // when they are of the kind, else computed. Either way used up.
   const mpgc_kernels::ChannelSums* UpdateSums(int slot_index, bool depth_only);
-  struct SlotData;
   // The kernels' input for a slot's least squares (and NCC).
-  mpgc_kernels::SumsInput KernelInput(const SlotData& sl,
-                                      bool depth_only) const;
+  mpgc_kernels::SumsInput KernelInput(int slot_index, bool depth_only) const;
   bool DepthStep();
   bool FullStep(bool fit_normal, bool fit_scale);
   bool MakeResult(int iterations, PatchResult* out) const;
