@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # Live against offline on the same images: a rendered scene with exact
 # ground truth is reconstructed by `wild_mvs reconstruct` and, written as a
-# bag (`wild_mvs to-bag`, one frame per view, --rate views per second),
+# bag (`wild_mvs to-bag`, one frame per view, --rate views per second; a
+# list "1 0.25" plays it at each rate),
 # played through the depth and fusion nodes (launch/reconstruct_bag.launch,
 # default parameters, its depth views recorded). Both are scored against the
-# ground truth: the published depth maps (first revisions and final
-# revisions, bench_live_depth_maps) and the offline maps with
+# ground truth: the published depth maps (revisions 0, 1 and final,
+# bench_live_depth_maps) and the offline maps with
 # `wild_mvs eval depth`, the fused clouds with `wild_mvs eval cloud`.
 #
 #   bench/run_live.sh [--families "relief courtyard"] [--seeds 101]
-#                     [--size 640] [--rate 1] [--out DIR] [--skip-build]
+#                     [--size 640] [--rate "1 0.25"] [--out DIR] [--skip-build]
 #                     [--sparse tracker|topic] [--robot]
 #
 # --sparse: where the depth node's sparse points come from: its own
@@ -30,8 +31,9 @@
 # bench/make_results.py names them when run_all.sh skipped this section and
 # it ran into OUT/live afterwards); first_s: seconds from an image to its keyframe's
 # first depth view (median/max, the bag's clock), revised_after: newer
-# keyframes that got their first depth view before a keyframe's final
-# revision (median/max).
+# keyframes that got their first depth view before a keyframe's revision 1
+# (its row) or final revision (median/max). Runs at a rate other than 1
+# are named with it ("live final revisions, 0.25 views/s").
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 COMMAND="bench/run_live.sh"
@@ -42,7 +44,7 @@ OUT="$ROOT/bench/out/live"
 FAMILIES="relief courtyard"
 SEEDS=101
 SIZE=640
-RATE=1
+RATE="1 0.25"
 SPARSE=tracker
 ROBOT=()
 BUILD=missing
@@ -159,16 +161,21 @@ for family in $FAMILIES; do
       printf '%s\t%s\toffline, own tracks\t%s/%s\t%s\t%s\t%.1f\t-\t-\n' "$kind" "$seed" \
         "$n" "$nviews" "${off// /	}" "${f// /	}" "$(echo "$u + $s" | bc)" >>"$TSV"
     fi
-    # Live.
-    points=()
-    [ "$SPARSE" = topic ] && points=(--with-points)
-    "$BIN/wild_mvs_to_bag" "$scene" "$run/scene.bag" --rate "$RATE" \
-      ${points[@]+"${points[@]}"} ${ROBOT[@]+"${ROBOT[@]}"} >"$run/bag.log" 2>&1
-    # The bag's clock (/clock, which the recorder stamps with) stops at its
-    # last message: a last, unused message 5 s after the last view keeps it
-    # running while the last keyframes are matched, so that their latency
-    # is measured, not cut off.
-    /usr/bin/python3 - "$run/scene.bag" <<'PY'
+    # Live, at each rate.
+    for rate in $RATE; do
+      lr="$run/live_$rate"
+      suffix=""
+      [ "$rate" = 1 ] || suffix=", $rate views/s"
+      mkdir -p "$lr"
+      points=()
+      [ "$SPARSE" = topic ] && points=(--with-points)
+      "$BIN/wild_mvs_to_bag" "$scene" "$lr/scene.bag" --rate "$rate" \
+        ${points[@]+"${points[@]}"} ${ROBOT[@]+"${ROBOT[@]}"} >"$lr/bag.log" 2>&1
+      # The bag's clock (/clock, which the recorder stamps with) stops at its
+      # last message: a last, unused message 5 s after the last view keeps it
+      # running while the last keyframes are matched, so that their latency
+      # is measured, not cut off.
+      /usr/bin/python3 - "$lr/scene.bag" <<'PY'
 import sys
 import rosbag
 import rospy
@@ -177,40 +184,48 @@ with rosbag.Bag(sys.argv[1], "a") as bag:
     bag.write("/bench/clock_tail", String(data="keeps the clock running"),
               rospy.Time.from_sec(bag.get_end_time() + 5.0))
 PY
-    roscore -p "$PORT" >"$run/roscore.log" 2>&1 &
-    core=$!
-    sleep 3
-    /usr/bin/time -f '%U %S' -o "$run/live.time" \
-      roslaunch wild_mvs reconstruct_bag.launch bag:="$run/scene.bag" \
-      output:="$run/live_fused.ply" record:="$run/live.bag" \
-      sparse_source:="$SPARSE" >"$run/live.log" 2>&1 || true
-    kill "$core" 2>/dev/null || true
-    wait "$core" 2>/dev/null || true
-    read -r u s <"$run/live.time"
-    cpu=$(echo "$u + $s" | bc)
-    for which in first final; do
-      flag=()
-      [ "$which" = first ] && flag=(--first)
-      "$BIN/bench_live_depth_maps" "$run/live.bag" "$scene" "$run/live_$which" \
-        ${flag[@]+"${flag[@]}"} >"$run/live_$which.log" 2>&1
-      n=$(ls "$run/live_$which/depth" 2>/dev/null | grep -c '\.pfm$' || true)
-      sc=$(score "$run/live_$which" "$scene")
-      if [ "$which" = final ] && [ -f "$run/live_fused.ply" ]; then
-        f=$(fscore "$run/live_fused.ply" "$scene")
-      else
-        f="- -"
-      fi
-      # How late: seconds from an image to its keyframe's first depth view
-      # (median/max), and newer keyframes' first views before its final
-      # revision (median/max).
-      lat=$(sed -n 's/^first depth view after its image: median \([0-9.]*\) s, max \([0-9.]*\) s$/\1 \2/p' \
-        "$run/live_$which.log" | awk '{printf "%.1f/%.1f", $1, $2}')
-      lag=$(sed -n 's/^final revision after \([0-9]*\) newer.* \([0-9]*\) (max).*/\1\/\2/p' \
-        "$run/live_$which.log")
-      if [ "$which" = first ]; then lag=-; else lat=-; fi
-      printf '%s\t%s\tlive %s revisions\t%s/%s\t%s\t%s\t%s\t%s\t%s\n' "$kind" "$seed" \
-        "$which" "$n" "$nviews" "${sc// /	}" "${f// /	}" \
-        "$([ "$which" = final ] && echo "$cpu" || echo -)" "${lat:--}" "${lag:--}" >>"$TSV"
+      roscore -p "$PORT" >"$lr/roscore.log" 2>&1 &
+      core=$!
+      sleep 3
+      /usr/bin/time -f '%U %S' -o "$lr/live.time" \
+        roslaunch wild_mvs reconstruct_bag.launch bag:="$lr/scene.bag" \
+        output:="$lr/live_fused.ply" record:="$lr/live.bag" \
+        sparse_source:="$SPARSE" >"$lr/live.log" 2>&1 || true
+      kill "$core" 2>/dev/null || true
+      wait "$core" 2>/dev/null || true
+      read -r u s <"$lr/live.time"
+      cpu=$(echo "$u + $s" | bc)
+      for which in first 1 final; do
+        flag=()
+        [ "$which" = first ] && flag=(--revision 0)
+        [ "$which" = 1 ] && flag=(--revision 1)
+        "$BIN/bench_live_depth_maps" "$lr/live.bag" "$scene" "$lr/live_$which" \
+          ${flag[@]+"${flag[@]}"} >"$lr/live_$which.log" 2>&1
+        n=$(ls "$lr/live_$which/depth" 2>/dev/null | grep -c '\.pfm$' || true)
+        sc=$(score "$lr/live_$which" "$scene")
+        if [ "$which" = final ] && [ -f "$lr/live_fused.ply" ]; then
+          f=$(fscore "$lr/live_fused.ply" "$scene")
+        else
+          f="- -"
+        fi
+        # How late: seconds from an image to its keyframe's first depth view
+        # (median/max), and newer keyframes' first views before its
+        # revision 1 or final revision (median/max).
+        lat=$(sed -n 's/^first depth view after its image: median \([0-9.]*\) s, max \([0-9.]*\) s$/\1 \2/p' \
+          "$lr/live_$which.log" | awk '{printf "%.1f/%.1f", $1, $2}')
+        case "$which" in
+          first) name="first revisions"; lag=- ;;
+          1) name="revisions 1"; lat=-
+             lag=$(sed -n 's/^revision 1 after \([0-9]*\) newer.* \([0-9]*\) (max).*/\1\/\2/p' \
+               "$lr/live_$which.log") ;;
+          final) name="final revisions"; lat=-
+             lag=$(sed -n 's/^final revision after \([0-9]*\) newer.* \([0-9]*\) (max).*/\1\/\2/p' \
+               "$lr/live_$which.log") ;;
+        esac
+        printf '%s\t%s\tlive %s%s\t%s/%s\t%s\t%s\t%s\t%s\t%s\n' "$kind" "$seed" \
+          "$name" "$suffix" "$n" "$nviews" "${sc// /	}" "${f// /	}" \
+          "$([ "$which" = final ] && echo "$cpu" || echo -)" "${lat:--}" "${lag:--}" >>"$TSV"
+      done
     done
   done
 done

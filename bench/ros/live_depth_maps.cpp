@@ -1,11 +1,11 @@
 // Copyright wild_mvs authors. The depth maps a live run published, as a
 // reconstruct folder that `wild_mvs eval depth` scores (bench/run_live.sh).
 //
-//   bench_live_depth_maps REC.bag DATASET OUT [--first]
+//   bench_live_depth_maps REC.bag DATASET OUT [--revision 0|1]
 //
 // Reads every wild_mvs/DepthView of REC.bag (the depth node's depth_view,
 // recorded by reconstruct_bag.launch record:=REC.bag), keeps per keyframe
-// its final revision (--first: its first, revision 0), finds the dataset
+// its final revision (--revision N: its revision N), finds the dataset
 // view it shows (the view whose camera centre is nearest, within 1 mm) and
 // writes OUT/depth/<stem>.pfm with its camera, as `wild_mvs reconstruct`
 // does. Prints the keyframes, views and revisions found. Exit 1 with a
@@ -14,7 +14,8 @@
 // Also prints how late the maps came, from the bag's record times (the
 // launch's clock: sim time, which the bag plays at its rate): per keyframe
 // the seconds from its image stamp to its first depth view, and how many
-// newer keyframes got their first depth view before its final revision.
+// newer keyframes got their first depth view before its revision 1 and
+// before its final revision.
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <wild_mvs/DepthView.h>
@@ -34,13 +35,17 @@ namespace wild_mvs {
 namespace {
 
 int Run(int argc, char** argv) {
-  if (argc < 4 || argc > 5 ||
-      (argc == 5 && std::string(argv[4]) != "--first")) {
-    std::cerr << "usage: bench_live_depth_maps REC.bag DATASET OUT [--first]\n";
+  const bool ok =
+      argc == 4 ||
+      (argc == 6 && std::string(argv[4]) == "--revision" &&
+       (std::string(argv[5]) == "0" || std::string(argv[5]) == "1"));
+  if (!ok) {
+    std::cerr << "usage: bench_live_depth_maps REC.bag DATASET OUT "
+                 "[--revision 0|1]\n";
     return 2;
   }
   const std::string bag_path = argv[1], out = argv[3];
-  const bool first = argc == 5;
+  const int wanted = argc == 6 ? std::stoi(argv[5]) : -1;  // -1: the final
   DatasetOptions dataset;
   dataset.path = argv[2];
   dataset.check_images = false;
@@ -48,9 +53,10 @@ int Run(int argc, char** argv) {
 
   std::map<uint64_t, wild_mvs::DepthViewConstPtr> by_stamp;
   // Per keyframe stamp: record time of its first depth view; order of first
-  // depth views; per keyframe the count of first views before its final.
+  // depth views; per keyframe the count of first views before its revision
+  // 1 and before its final revision.
   std::map<uint64_t, double> first_at;
-  std::map<uint64_t, int> first_order, final_after;
+  std::map<uint64_t, int> first_order, early_after, final_after;
   int messages = 0, revised = 0;
   rosbag::Bag bag;
   try {
@@ -68,13 +74,15 @@ int Run(int argc, char** argv) {
       first_at[key] = m.getTime().toSec() - v->header.stamp.toSec();
       first_order[key] = static_cast<int>(first_order.size());
     }
-    if (v->final_revision)
-      final_after[key] =
-          static_cast<int>(first_order.size()) - 1 - first_order[key];
+    const int newer =
+        static_cast<int>(first_order.size()) - 1 - first_order[key];
+    if (v->revision == 1) early_after[key] = newer;
+    if (v->final_revision) final_after[key] = newer;
     auto it = by_stamp.find(key);
     const bool take =
-        first ? (v->revision == 0 && it == by_stamp.end())
-              : (it == by_stamp.end() || v->revision >= it->second->revision);
+        wanted >= 0
+            ? (static_cast<int>(v->revision) == wanted && it == by_stamp.end())
+            : (it == by_stamp.end() || v->revision >= it->second->revision);
     if (take) by_stamp[key] = v;
   }
   Require(messages > 0, bag_path, ": no wild_mvs/DepthView message");
@@ -102,18 +110,21 @@ int Run(int argc, char** argv) {
   std::vector<double> lat;
   for (const auto& [k, t] : first_at) lat.push_back(t);
   std::sort(lat.begin(), lat.end());
-  std::vector<int> lag;
-  for (const auto& [k, n] : final_after) lag.push_back(n);
-  std::sort(lag.begin(), lag.end());
   if (!lat.empty()) {
     std::cout << "first depth view after its image: median "
               << lat[lat.size() / 2] << " s, max " << lat.back() << " s\n";
   }
-  if (!lag.empty()) {
-    std::cout << "final revision after " << lag[lag.size() / 2]
+  for (const auto& [name, after] :
+       {std::make_pair("revision 1", &early_after),
+        std::make_pair("final revision", &final_after)}) {
+    std::vector<int> lag;
+    for (const auto& [k, n] : *after) lag.push_back(n);
+    std::sort(lag.begin(), lag.end());
+    if (lag.empty()) continue;
+    std::cout << name << " after " << lag[lag.size() / 2]
               << " newer keyframes' first views (median), " << lag.back()
               << " (max); " << lag.size() << " of " << first_at.size()
-              << " keyframes have a final revision\n";
+              << " keyframes have a " << name << "\n";
   }
   std::cout << messages << " depth views (" << revised << " revisions), "
             << by_stamp.size() << " keyframes, " << written << " of "

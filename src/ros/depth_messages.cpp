@@ -141,7 +141,8 @@ void FillDepthDiagnostics(const StreamStats& s, const DepthInputStats& in,
   stat.add("depth maps", s.reconstructed);
   stat.add("depth maps running", s.running);
   stat.add("depth maps cancelled", s.cancelled);
-  stat.add("depth maps revised", s.revised);
+  stat.add("revisions 1", s.early_revised);
+  stat.add("depth maps revised", s.revised);  // final revisions
   stat.add("revisions to come", s.unrevised);
   stat.add("reconstructions failed", s.failed);
   stat.add("keyframes evicted before reconstruction", s.evicted_waiting);

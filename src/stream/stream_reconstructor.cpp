@@ -35,6 +35,23 @@ std::shared_ptr<const DepthMap> DepthOnly(const DepthMap& map) {
   d->depth = map.depth;
   return d;
 }
+
+// Filters `depth` against the `maps` neighbours' maps in `workspace`:
+// consistent with as many of them as mvs.consistency asks for, or with all
+// of them when fewer are held (none: nothing is confirmed). Returns the
+// error, empty if none.
+std::string CheckAgainstMaps(MvsOptions mvs,
+                             const MemoryDepthWorkspace& workspace, int maps,
+                             DepthMap* depth) {
+  mvs.consistency.min_consistent =
+      std::max(1, std::min(mvs.consistency.min_consistent, maps));
+  try {
+    *depth = DepthController(mvs, nullptr).Filter(*depth, workspace).map;
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
 }  // namespace
 
 void StreamOptions::Check() const {
@@ -112,7 +129,9 @@ void StreamReconstructor::ClearLocked() {
   held_.clear();
   previewing_.clear();
   rematched_.clear();
+  early_newest_.clear();
   revising_.clear();
+  last_keyframe_interval_ = 0;
   ++generation_;
   next_id_ = 0;  // ids restart in the new session
   session_ = -1;
@@ -250,7 +269,10 @@ StreamReconstructor::FrameStatus StreamReconstructor::AddFrame(
       ForgetLocked(e->id);
     }
     ++stats_.keyframes_total;
-    last_keyframe_wall_ = WallSeconds();
+    const double now = WallSeconds();
+    if (last_keyframe_wall_ > 0)
+      last_keyframe_interval_ = now - last_keyframe_wall_;
+    last_keyframe_wall_ = now;
     idle_scheduled_ = false;
   }
 
@@ -380,9 +402,16 @@ StreamReconstructor::Neighborhood StreamReconstructor::Evaluate(
   return nb;
 }
 
+bool StreamReconstructor::IdleLocked() const {
+  // The stream paused, not merely slowed down: no keyframe for idle_flush s
+  // and for twice the interval between the last two.
+  const double quiet = WallSeconds() - last_keyframe_wall_;
+  return quiet >= options_.idle_flush && quiet >= 2 * last_keyframe_interval_;
+}
+
 void StreamReconstructor::ScheduleLocked() {
   ready_waiting_ = 0;
-  const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
+  const bool idle = IdleLocked();
   if (idle) idle_scheduled_ = true;
   ScheduleMatchingLocked(idle);
   if (idle) FlushHeldPreviewsLocked();
@@ -449,9 +478,10 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
   // keyframe's map is what a robot waits for: the revisions' threads have
   // background priority).
   if (stopping_ || !revising_.empty()) return;
-  // A neighbour is settled for step `rematched` when the store no longer
-  // holds it, another worker owns it, its matching failed, or it reached
-  // that step.
+  // A neighbour is settled for a step when the store no longer holds it,
+  // another worker owns it, its matching failed, or it reached that step:
+  // matched (`rematched` false) or matched again over a full
+  // neighbourhood (true).
   auto settled = [this](uint32_t n, bool rematched) {
     const KeyframePtr k = store_.Get(n);
     if (!k || !k->owned) return true;
@@ -460,50 +490,69 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
                      : k->done() && !in_flight_.count(n);
   };
   const KeyframePtr newest = store_.Newest();
-  // A full neighbourhood, as offline: the store holds as many other
-  // keyframes as the view selection picks.
-  const bool full_store = static_cast<int>(store_.size()) >
-                          std::min(options_.mvs.global.num_neighbors,
-                                   options_.store.max_keyframes - 1);
+  const uint32_t newest_id = newest ? newest->id : 0;
   for (const auto& [id, pending] : unrevised_) {
     // Not before its preview went out (revision 0 comes first).
     if (held_.count(id) || previewing_.count(id)) continue;
-    // Step 1, matching again, once the neighbours of the first match are
-    // matched, the store holds a full neighbourhood and the keyframes up to
-    // `lookahead` after it have `lookahead` later keyframes themselves (the
-    // sparse tracks through its neighbours on both sides are then as the
-    // offline tracker would have them); step 2, the filter, once the new
-    // neighbours are matched again too (their maps are then what the
-    // offline filter would see). At the idle flush nothing is waited for.
-    const bool rematched = rematched_.count(id) > 0;
-    bool ready = rematched ||
-                 (full_store && newest &&
-                  static_cast<int64_t>(newest->id) - static_cast<int64_t>(id) >=
-                      2 * options_.lookahead);
-    for (uint32_t n : pending.neighbor_ids)
-      if (n != id && !settled(n, rematched)) ready = false;
-    if (!ready && !idle) continue;
-    // Even at the idle flush, the filter never judges against a
-    // neighbour's preview when that neighbour is still to be matched again.
+    const std::vector<uint32_t>& nbs = pending.neighbor_ids;
     const uint32_t rid = id;
-    if (rematched &&
-        std::any_of(pending.neighbor_ids.begin(), pending.neighbor_ids.end(),
-                    [this, rid](uint32_t n) {
-                      return n != rid && unrevised_.count(n) &&
-                             !rematched_.count(n);
-                    }))
-      continue;
+    auto all_settled = [&](bool rematched) {
+      return std::all_of(nbs.begin(), nbs.end(), [&](uint32_t n) {
+        return n == rid || settled(n, rematched);
+      });
+    };
+    auto early = early_newest_.find(id);
+    // At the idle flush, a keyframe whose store is as at revision 1 has
+    // nothing new to be matched against.
+    if (idle && early != early_newest_.end() && early->second == newest_id)
+      rematched_.insert(id);
+    RevisionStep step;
+    bool ready;
+    if (early == early_newest_.end()) {
+      // Revision 1: matched again once the `lookahead` keyframes after it
+      // exist (neighbours on both sides) and the neighbours of its first
+      // match are matched.
+      step = RevisionStep::kEarly;
+      ready = static_cast<int64_t>(newest_id) - static_cast<int64_t>(id) >=
+                  options_.lookahead &&
+              all_settled(false);
+    } else if (!rematched_.count(id)) {
+      // Matched again over a full neighbourhood (revision 1 had fewer
+      // keyframes to choose from: a stream's start).
+      step = RevisionStep::kRematch;
+      ready = FullStoreLocked() && all_settled(false);
+    } else {
+      // Revision 2, final: checked against its neighbours' maps once those
+      // are matched again too (the maps the offline filter would see).
+      step = RevisionStep::kFinal;
+      ready = all_settled(true);
+      // Even at the idle flush, never against a neighbour's map that is
+      // still to be matched again.
+      if (std::any_of(nbs.begin(), nbs.end(), [this, rid](uint32_t n) {
+            return n != rid && unrevised_.count(n) && !rematched_.count(n);
+          }))
+        continue;
+    }
+    if (!ready && !idle) continue;
     revising_.insert(id);
     const uint64_t gen = generation_;
-    revision_dispatcher_->Submit([this, rid, gen, rematched] {
-      if (rematched) {
+    revision_dispatcher_->Submit([this, rid, gen, step, idle] {
+      if (step == RevisionStep::kFinal) {
         RunRevisionFilter(rid, gen);
       } else {
-        RunRevisionMatch(rid, gen);
+        RunRevisionMatch(rid, gen, step, idle);
       }
     });
     return;
   }
+}
+
+bool StreamReconstructor::FullStoreLocked() const {
+  // A full neighbourhood, as offline: the store holds as many other
+  // keyframes as the view selection picks.
+  return static_cast<int>(store_.size()) >
+         std::min(options_.mvs.global.num_neighbors,
+                  options_.store.max_keyframes - 1);
 }
 
 int StreamReconstructor::NeighborMapsLocked(
@@ -528,6 +577,7 @@ void StreamReconstructor::EndRevisionStepLocked(uint32_t id) {
 
 void StreamReconstructor::ForgetLocked(uint32_t id) {
   maps_.erase(id);
+  early_newest_.erase(id);
   unrevised_.erase(id);
   held_.erase(id);
   rematched_.erase(id);
@@ -564,11 +614,14 @@ double StreamReconstructor::MatchKeyframe(const Snapshot& snap, int ref,
   return score;
 }
 
-void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
+void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation,
+                                           RevisionStep step, bool idle) {
   StreamResult result;
   Snapshot snap;
   int ref = -1;
   MvsOptions mvs;
+  bool full = false;
+  uint32_t newest_id = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = unrevised_.find(id);
@@ -580,6 +633,8 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
     snap = MakeSnapshotLocked();
     for (size_t i = 0; i < snap.keyframes.size(); ++i)
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
+    if (!snap.keyframes.empty()) newest_id = snap.keyframes.back()->id;
+    full = FullStoreLocked();
     mvs = options_.mvs;
     ++stats_.running;
   }
@@ -600,16 +655,51 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation) {
   }
   if (!error.empty() && on_error_)
     on_error_(Msg("keyframe ", id, ": matching again failed: ", error));
-  std::lock_guard<std::mutex> lock(mutex_);
-  --stats_.running;
-  auto it = unrevised_.find(id);
-  if (generation == generation_ && it != unrevised_.end()) {
-    if (ref >= 0 && error.empty()) {
+  const bool matched = ref >= 0 && error.empty();
+  MemoryDepthWorkspace workspace;
+  int maps = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --stats_.running;
+    auto it = unrevised_.find(id);
+    if (generation != generation_ || it == unrevised_.end()) {
+      EndRevisionStepLocked(id);
+      return;
+    }
+    if (matched) {
       it->second = result;
       maps_[id] = DepthOnly(result.depth);
     }
-    rematched_.insert(id);
+    if (step == RevisionStep::kEarly) early_newest_[id] = newest_id;
+    // Over a full neighbourhood this is the final match (so is any at the
+    // idle flush, and a failed one: the map it has stays).
+    if (full || idle || !matched) rematched_.insert(id);
+    if (step != RevisionStep::kEarly || !matched) {
+      EndRevisionStepLocked(id);
+      return;
+    }
+    maps = NeighborMapsLocked(result, &workspace);
+    mvs = options_.mvs;
   }
+  // Revision 1: checked against the maps its neighbours have now (the
+  // newest ones' first maps among them) and delivered at once.
+  error = CheckAgainstMaps(mvs, workspace, maps, &result.depth);
+  result.revision = 1;
+  result.final_revision = false;
+  bool deliver = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (generation != generation_) {
+      ++stats_.stale_results;
+    } else if (error.empty()) {
+      ++stats_.early_revised;
+      deliver = true;
+    }
+  }
+  if (!error.empty() && on_error_)
+    on_error_(Msg("keyframe ", id, ": checking revision 1 failed: ", error));
+  if (deliver && on_result_) on_result_(result);
+  std::lock_guard<std::mutex> lock(mutex_);
   EndRevisionStepLocked(id);
 }
 
@@ -638,7 +728,7 @@ void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
   } catch (const std::exception& e) {
     error = e.what();
   }
-  result.revision = 1;
+  result.revision = 2;
   result.final_revision = true;
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
@@ -668,7 +758,7 @@ void StreamReconstructor::Tick() {
   // Every event (keyframe, sparse points, finished map, reset) schedules at
   // once; the only thing time changes is the idle flush, done once per
   // quiet spell.
-  const bool idle = WallSeconds() - last_keyframe_wall_ >= options_.idle_flush;
+  const bool idle = IdleLocked();
   if (!idle || idle_scheduled_) return;
   ScheduleLocked();
   idle_scheduled_ = true;
@@ -822,17 +912,8 @@ void StreamReconstructor::DeliverCheckedPreviews(uint64_t generation,
       maps = NeighborMapsLocked(result, &workspace);
       mvs = options_.mvs;
     }
-    // Consistent with as many neighbours' maps as it asks for, or with all
-    // of them when it has fewer (none: nothing is confirmed).
-    mvs.consistency.min_consistent =
-        std::max(1, std::min(mvs.consistency.min_consistent, maps));
-    std::string error;
-    try {
-      result.depth =
-          DepthController(mvs, nullptr).Filter(result.depth, workspace).map;
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
+    const std::string error =
+        CheckAgainstMaps(mvs, workspace, maps, &result.depth);
     if (!error.empty()) {
       if (on_error_)
         on_error_(Msg("keyframe ", result.keyframe_id,
@@ -981,13 +1062,14 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
         .Min(1);
     registry
         ->Add(key("lookahead"), &o->lookahead,
-              "a revision waits until the keyframes up to this many after "
-              "it have this many later keyframes (or idle_flush s without one)")
+              "later keyframes a keyframe's revision 1 waits for (or the "
+              "idle flush)")
         .Min(0);
     registry
         ->Add(key("idle_flush"), &o->idle_flush,
-              "s without a new keyframe after which waiting keyframes are "
-              "matched and revised")
+              "s without a new keyframe (and at least twice the last "
+              "keyframe interval) after which waiting keyframes are matched "
+              "and revised")
         .Min(0);
     registry
         ->Add(key("worker_index"), &o->worker_index,

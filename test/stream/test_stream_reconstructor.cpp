@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <set>
 #include <thread>
 
@@ -101,9 +102,11 @@ TEST(StreamReconstructor, DepthMapsMatchGroundTruth) {
   EXPECT_TRUE(c.errors.empty()) << c.errors.front();
   const StreamStats st = stream.Stats();
   EXPECT_EQ(st.keyframes_total, 6u);
-  // Every keyframe is matched once and revised once (the consistency step).
-  ASSERT_EQ(c.results.size(), 12u);
+  // Every keyframe is matched once and revised twice (revision 1, then the
+  // final one).
+  ASSERT_EQ(c.results.size(), 18u);
   EXPECT_EQ(st.reconstructed, 6u);
+  EXPECT_EQ(st.early_revised, 6u);
   EXPECT_EQ(st.revised, 6u);
   EXPECT_EQ(st.unrevised, 0);
   std::set<uint32_t> ids;
@@ -166,7 +169,9 @@ TEST(StreamReconstructor, KeyframeWithoutSharedFeaturesIsMatchedWhenIdle) {
 // The live path runs the offline pipeline's steps: a keyframe is delivered
 // as matched, mostly against earlier keyframes (revision 0, not final),
 // then matched again once later keyframes exist, with neighbours on both
-// sides, and checked against its neighbours' maps (revision 1, final). The
+// sides, and checked against the maps its neighbours have then (revision
+// 1, not final), then checked against its neighbours' maps matched again
+// (revision 2, final). Revision 1 is more accurate than revision 0; the
 // final maps are as good as the offline pipeline's on the same images.
 TEST(StreamReconstructor, FinalRevisionsAreTheOfflinePipelines) {
   const SyntheticScene& s = Scene6();
@@ -175,21 +180,29 @@ TEST(StreamReconstructor, FinalRevisionsAreTheOfflinePipelines) {
   StreamReconstructor stream(options, c.OnResult(), c.OnError());
   Play(stream, s);
   EXPECT_TRUE(c.errors.empty()) << c.errors.front();
-  std::map<uint32_t, StreamResult> first, last;
+  std::map<uint32_t, StreamResult> first, early, last;
   for (const StreamResult& r : c.results) {
     if (r.revision == 0) {
       EXPECT_FALSE(r.final_revision);
       EXPECT_FALSE(first.count(r.keyframe_id));
       first[r.keyframe_id] = r;
+    } else if (r.revision == 1) {
+      EXPECT_FALSE(r.final_revision);
+      EXPECT_TRUE(first.count(r.keyframe_id)) << "revision 1 before 0";
+      EXPECT_FALSE(early.count(r.keyframe_id));
+      EXPECT_EQ(r.stamp_ns, first[r.keyframe_id].stamp_ns);
+      early[r.keyframe_id] = r;
     } else {
-      EXPECT_EQ(r.revision, 1);
+      EXPECT_EQ(r.revision, 2);
       EXPECT_TRUE(r.final_revision);
-      EXPECT_TRUE(first.count(r.keyframe_id)) << "revision before the first";
+      EXPECT_TRUE(early.count(r.keyframe_id)) << "revision 2 before 1";
+      EXPECT_FALSE(last.count(r.keyframe_id));
       EXPECT_EQ(r.stamp_ns, first[r.keyframe_id].stamp_ns);
       last[r.keyframe_id] = r;
     }
   }
   ASSERT_EQ(first.size(), 6u);
+  ASSERT_EQ(early.size(), 6u);
   ASSERT_EQ(last.size(), 6u);
   // Inner keyframes are revised with neighbours on both sides.
   for (uint32_t id = 1; id + 1 < 6; ++id) {
@@ -209,7 +222,7 @@ TEST(StreamReconstructor, FinalRevisionsAreTheOfflinePipelines) {
   for (int v = 0; v < n; ++v)
     raw[v] = ReconstructView(s.scene, v, images, options.mvs, &pool, nullptr,
                              cv::Mat());
-  testing::PooledDepthMetrics offline, live_first, live_final;
+  testing::PooledDepthMetrics offline, live_first, live_early, live_final;
   for (int v = 0; v < n; ++v) {
     DepthMap m = raw[v];
     m.depth = raw[v].depth.clone();
@@ -220,21 +233,66 @@ TEST(StreamReconstructor, FinalRevisionsAreTheOfflinePipelines) {
     const Camera& gt_camera = s.scene.views[v].camera;
     offline.Add(EvaluateDepth(m.depth, m.camera, s.depth[v], gt_camera));
     const DepthMap& d0 = first.at(v).depth;
-    const DepthMap& d1 = last.at(v).depth;
+    const DepthMap& d1 = early.at(v).depth;
+    const DepthMap& d2 = last.at(v).depth;
     live_first.Add(EvaluateDepth(d0.depth, d0.camera, s.depth[v], gt_camera));
-    live_final.Add(EvaluateDepth(d1.depth, d1.camera, s.depth[v], gt_camera));
+    live_early.Add(EvaluateDepth(d1.depth, d1.camera, s.depth[v], gt_camera));
+    live_final.Add(EvaluateDepth(d2.depth, d2.camera, s.depth[v], gt_camera));
   }
   std::printf(
-      "coverage / within 1 %% / off > 5 %%: first %.3f %.3f %.2f %%, final "
-      "%.3f %.3f %.2f %%, offline %.3f %.3f %.2f %%\n",
+      "coverage / within 1 %% / off > 5 %%: first %.3f %.3f %.2f %%, "
+      "revision 1 %.3f %.3f %.2f %%, final %.3f %.3f %.2f %%, offline %.3f "
+      "%.3f %.2f %%\n",
       live_first.coverage(), live_first.within1(), 100 * live_first.off5pc(),
+      live_early.coverage(), live_early.within1(), 100 * live_early.off5pc(),
       live_final.coverage(), live_final.within1(), 100 * live_final.off5pc(),
       offline.coverage(), offline.within1(), 100 * offline.off5pc());
+  EXPECT_GT(live_early.within1(), live_first.within1());
+  EXPECT_LT(live_early.off5pc(), live_first.off5pc());
   EXPECT_GT(live_final.within1(), live_first.within1());
   EXPECT_LT(live_final.off5pc(), live_first.off5pc());
   EXPECT_GT(live_final.within1(), offline.within1() - 0.005);
   EXPECT_LT(live_final.off5pc(), offline.off5pc() + 0.002);
   EXPECT_GT(live_final.coverage(), offline.coverage() - 0.02);
+}
+
+// Revision 1 comes within `lookahead` keyframes: keyframes fed one at a
+// time, each after the work it made possible is done (a stream slower than
+// the machine), keyframe k is revised once keyframe k + lookahead arrives,
+// not before; its final revision (2) follows, once.
+TEST(StreamReconstructor, RevisionOneComesWithinLookaheadKeyframes) {
+  const SyntheticScene& s = Scene6();
+  StreamOptions o = FastOptions();
+  o.lookahead = 2;
+  o.idle_flush = 1e3;  // no idle flush while frames arrive
+  Collector c;
+  StreamReconstructor stream(o, c.OnResult(), c.OnError());
+  stream.SetSparsePoints(StampedPoints(s));
+  const int n = static_cast<int>(s.scene.views.size());
+  for (int i = 0; i < n; ++i) {
+    stream.AddFrame(double(i), "camera", s.scene.views[i].camera, s.images[i]);
+    stream.WaitIdle();
+    std::set<uint32_t> revised;
+    {
+      std::lock_guard<std::mutex> lock(c.mutex);
+      for (const StreamResult& r : c.results)
+        if (r.revision == 1) revised.insert(r.keyframe_id);
+    }
+    for (int k = 0; k < n; ++k)
+      EXPECT_EQ(revised.count(k) > 0, k + o.lookahead <= i)
+          << "keyframe " << k << " after keyframe " << i;
+  }
+  EXPECT_TRUE(c.errors.empty()) << c.errors.front();
+  // Each revision at most once, in order (the finals of the last keyframes
+  // come at the idle flush: FinalRevisionsAreTheOfflinePipelines).
+  std::map<uint32_t, std::vector<int>> revisions;
+  for (const StreamResult& r : c.results)
+    revisions[r.keyframe_id].push_back(r.revision);
+  for (const auto& [id, seen] : revisions) {
+    std::vector<int> expected(seen.size());
+    std::iota(expected.begin(), expected.end(), 0);
+    EXPECT_EQ(seen, expected) << "keyframe " << id;
+  }
 }
 
 // A stream's first keyframe has one neighbour when the second arrives. By
@@ -261,9 +319,12 @@ TEST(StreamReconstructor, FirstKeyframesArePreviewedFromTwoViews) {
       EXPECT_TRUE(c.results.empty()) << "a final map from two views";
       continue;
     }
-    ASSERT_EQ(c.results.size(), 2u);
-    for (const StreamResult& r : c.results) {
-      EXPECT_EQ(r.revision, 0);
+    // The two previews (and keyframe 0's revision 1: lookahead 1).
+    std::vector<StreamResult> previews;
+    for (const StreamResult& r : c.results)
+      if (r.revision == 0) previews.push_back(r);
+    ASSERT_EQ(previews.size(), 2u);
+    for (const StreamResult& r : previews) {
       EXPECT_FALSE(r.final_revision);
       const uint32_t other = 1 - r.keyframe_id;
       EXPECT_EQ(r.neighbor_ids, std::vector<uint32_t>{other});
@@ -322,11 +383,12 @@ TEST(StreamReconstructor, NoTwoViewPreviewsAfterAPoseJump) {
   }
   stream.WaitIdle();
   EXPECT_TRUE(c.errors.empty()) << c.errors.front();
-  ASSERT_EQ(c.results.size(), 2u) << "previews after the jump";
+  int previews = 0;
   for (const StreamResult& r : c.results) {
     EXPECT_LT(r.stamp, 0.3) << "keyframe of the jumped session";
-    EXPECT_EQ(r.revision, 0);
+    previews += r.revision == 0;
   }
+  EXPECT_EQ(previews, 2);
 }
 
 // Real-world stamps (epoch seconds with microseconds, 30 Hz) come back bit
@@ -359,7 +421,7 @@ TEST(StreamReconstructor, EpochStampsPassThroughExactly) {
     if (stream.Stats().pending == 0 && k > 8) break;
   }
   stream.WaitIdle();
-  ASSERT_EQ(c.results.size(), 12u);  // each keyframe and its revision
+  ASSERT_EQ(c.results.size(), 18u);  // each keyframe and its revisions
   for (const StreamResult& r : c.results) {
     EXPECT_EQ(r.stamp_ns, stamp_of(r.keyframe_id));
     EXPECT_EQ(r.session_ns, t0);

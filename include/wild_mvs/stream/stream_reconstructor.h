@@ -16,18 +16,22 @@
 // soon as it has enough neighbours, mostly earlier ones, and that map is
 // delivered at once (revision 0). With the consistency step on
 // (mvs.ablation.consistency, as offline) that first map is a preview at
-// half the working size, and it is revised once, when every neighbour it
-// was matched against is done (matched by this worker, owned by another,
-// failed or evicted), the store holds mvs.global.num_neighbors other
-// keyframes and the keyframes after it are tracked (`lookahead`; or at the
-// idle flush): matched again at the working size
-// over every keyframe held, so with neighbours on both sides as offline;
-// once those neighbours are matched again too (or at the idle flush), it is
-// checked against their maps (FilterByConsistency with mvs.consistency, the
-// offline filter on the maps offline would have) and delivered as revision
-// 1, same stamp. One revision step runs at a time, beside the first
-// matches, on threads of background priority (ThreadPool::Priority): a first
-// match never waits for a revision and takes the cores whenever it runs.
+// half the working size, and two revisions follow, same stamp, each a
+// step of the offline pipeline. Revision 1, within `lookahead` keyframes:
+// once the `lookahead` keyframes after it exist and every neighbour it was
+// matched against is done (matched by this worker, owned by another,
+// failed or evicted), it is matched again at the working size over every
+// keyframe held, so with neighbours on both sides, checked against the
+// maps its neighbours have then (FilterByConsistency) and delivered.
+// Revision 2, final: the offline filter (FilterByConsistency with
+// mvs.consistency) on the maps offline would have, once its neighbours
+// are matched again too; a keyframe whose revision 1 was matched while
+// the store held fewer than mvs.global.num_neighbors other keyframes (a
+// stream's start) is first matched again once it holds them. At the idle
+// flush nothing is waited for. One revision step runs at a time, beside
+// the first matches, on threads of background priority
+// (ThreadPool::Priority): a first match never waits for a revision and
+// takes the cores whenever it runs.
 // Memory: the depth of every matched keyframe held (4 bytes per pixel), the
 // first result of the keyframes not yet revised (both go with the keyframe
 // when the store evicts it), and at most one first match and one revision
@@ -98,10 +102,10 @@ struct StreamOptions {
   // keyframe waits for mvs.mpgc.min_active_views neighbours.
   int min_neighbors = 1;
   // A keyframe is matched as soon as it has min_neighbors good neighbours.
-  // Its revision waits until the keyframes up to `lookahead` after it have
-  // `lookahead` later keyframes themselves and the store holds
-  // mvs.global.num_neighbors other keyframes, or for `idle_flush` s (wall
-  // time) without a new keyframe.
+  // Its revision 1 waits for `lookahead` later keyframes (>= 0). The idle
+  // flush (nothing waited for) comes when no keyframe arrived for
+  // `idle_flush` s (wall time, >= 0) and for twice the interval between
+  // the last two keyframes (the stream paused, not merely slowed down).
   int lookahead = 2;
   double idle_flush = 1.0;
   // Longest image side kept, pixels, 0 or >= 16 (input downscaled at
@@ -148,7 +152,9 @@ struct StreamResult {
   uint64_t session_ns = 0;
   uint64_t stamp_ns = 0;
   std::string frame_id;
-  int revision = 0;  // 0 = as matched, 1 = checked against neighbours' maps
+  // 0 = first map; 1 = matched again with later keyframes, checked against
+  // the neighbours' maps then held; 2 = final (see the file comment)
+  int revision = 0;
   bool final_revision = true;  // no later revision of this keyframe follows
   std::vector<uint32_t> neighbor_ids;        // keyframe ids matched against
   std::vector<double> neighbor_stamps;       // and their stamps
@@ -167,8 +173,9 @@ struct StreamStats {
   int pending = 0;               // reconstructions queued or running
   int waiting = 0;               // ready keyframes waiting for a free slot
   uint64_t reconstructed = 0;    // depth maps matched (revision 0)
-  uint64_t revised = 0;          // revisions delivered (revision 1)
-  int unrevised = 0;    // revision 0 delivered, revision 1 to come (queued,
+  uint64_t early_revised = 0;    // revisions 1 delivered
+  uint64_t revised = 0;          // final revisions delivered (revision 2)
+  int unrevised = 0;    // revision 0 delivered, the final to come (queued,
                         // running or waiting for the neighbours)
   uint64_t failed = 0;  // reconstructions that threw
   uint64_t evicted_waiting = 0;  // owned keyframes evicted before their
@@ -320,8 +327,20 @@ class StreamReconstructor {
   void DeliverCheckedPreviews(uint64_t generation, bool idle);
   // At the idle flush: DeliverCheckedPreviews(idle) on the dispatcher.
   void FlushHeldPreviewsLocked();
-  void RunRevisionMatch(uint32_t id, uint64_t generation);   // step 1
-  void RunRevisionFilter(uint32_t id, uint64_t generation);  // step 2
+  // A keyframe's revision steps, in order (see the file comment).
+  enum class RevisionStep {
+    kEarly,    // matched again, checked, delivered as revision 1
+    kRematch,  // matched again over a full neighbourhood
+    kFinal,    // checked against the neighbours' final maps: revision 2
+  };
+  // kEarly or kRematch; `idle`: scheduled by the idle flush.
+  void RunRevisionMatch(uint32_t id, uint64_t generation, RevisionStep step,
+                        bool idle);
+  void RunRevisionFilter(uint32_t id, uint64_t generation);  // kFinal
+  // The store holds as many other keyframes as the view selection picks.
+  bool FullStoreLocked() const;
+  // No keyframe for idle_flush s and for twice the last keyframe interval.
+  bool IdleLocked() const;
   // Matches keyframe `ref` of `snap` (ReconstructView over the snapshot):
   // sets result->depth and its neighbours; returns the neighbour score.
   double MatchKeyframe(const Snapshot& snap, int ref, const MvsOptions& mvs,
@@ -350,7 +369,11 @@ class StreamReconstructor {
   // first results waiting for their revision, and revisions in flight.
   std::map<uint32_t, std::shared_ptr<const DepthMap>> maps_;
   std::map<uint32_t, StreamResult> unrevised_;
-  std::set<uint32_t> rematched_;  // held keyframes matched again (step 1)
+  // Held keyframes matched again over a full neighbourhood (or at the idle
+  // flush), and those whose revision 1 went out, with the newest keyframe
+  // id it was matched with.
+  std::set<uint32_t> rematched_;
+  std::map<uint32_t, uint32_t> early_newest_;
   // Previews from fewer than mvs.mpgc.min_active_views neighbours, waiting
   // for their neighbours' maps (DeliverCheckedPreviews).
   std::map<uint32_t, StreamResult> held_;
@@ -361,10 +384,11 @@ class StreamReconstructor {
   uint32_t next_id_ = 0;
   uint64_t generation_ = 0;
   bool idle_scheduled_ = false;
-  std::atomic<bool> cancel_{false};  // set by Shutdown()
-  bool shut_down_ = false;           // the idle
-                                     // flush ran since the last keyframe
-  double last_keyframe_wall_ = 0;    // steady clock, s
+  std::atomic<bool> cancel_{false};    // set by Shutdown()
+  bool shut_down_ = false;             // the idle
+                                       // flush ran since the last keyframe
+  double last_keyframe_wall_ = 0;      // steady clock, s
+  double last_keyframe_interval_ = 0;  // s between the last two keyframes
   double last_stamp_ = -1;
   double session_ = -1;             // see StreamResult::session
   bool pose_jump_session_ = false;  // the current session began at a jump
