@@ -491,6 +491,11 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
   };
   const KeyframePtr newest = store_.Newest();
   const uint32_t newest_id = newest ? newest->id : 0;
+  // The oldest ready revision 1 first (what a robot waits for), else the
+  // oldest ready step towards a final revision.
+  bool chosen = false;
+  uint32_t chosen_id = 0;
+  RevisionStep chosen_step = RevisionStep::kFinal;
   for (const auto& [id, pending] : unrevised_) {
     // Not before its preview went out (revision 0 comes first).
     if (held_.count(id) || previewing_.count(id)) continue;
@@ -534,17 +539,23 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
         continue;
     }
     if (!ready && !idle) continue;
-    revising_.insert(id);
-    const uint64_t gen = generation_;
-    revision_dispatcher_->Submit([this, rid, gen, step, idle] {
-      if (step == RevisionStep::kFinal) {
-        RunRevisionFilter(rid, gen);
-      } else {
-        RunRevisionMatch(rid, gen, step, idle);
-      }
-    });
-    return;
+    if (chosen && step != RevisionStep::kEarly) continue;
+    chosen = true;
+    chosen_id = id;
+    chosen_step = step;
+    if (step == RevisionStep::kEarly) break;
   }
+  if (!chosen) return;
+  revising_.insert(chosen_id);
+  const uint64_t gen = generation_;
+  revision_dispatcher_->Submit(
+      [this, id = chosen_id, gen, step = chosen_step, idle] {
+        if (step == RevisionStep::kFinal) {
+          RunRevisionFilter(id, gen);
+        } else {
+          RunRevisionMatch(id, gen, step, idle);
+        }
+      });
 }
 
 bool StreamReconstructor::FullStoreLocked() const {

@@ -190,23 +190,23 @@ TEST_F(SelectorWorkers, KeyframeIdsAreConsecutive) {
     EXPECT_EQ(run_->selected[i]->keyframe_id, i);
 }
 
-// Matched once (revision 0), then revised once (the consistency step
-// against the worker's own neighbour maps), by its owner, under the
-// selector's numbering and session.
-TEST_F(SelectorWorkers, EveryKeyframeIsMatchedAndRevisedOnceByItsOwner) {
+// Matched once (revision 0), then revised twice (revision 1, then the
+// final one: the consistency step against the worker's own neighbour
+// maps), by its owner, under the selector's numbering and session.
+TEST_F(SelectorWorkers, EveryKeyframeIsMatchedOnceAndRevisedByItsOwner) {
   for (size_t i = 0; i < run_->selected.size(); ++i) {
     const wild_mvs::SelectedKeyframe& k = *run_->selected[i];
     const uint64_t s = k.header.stamp.toNSec();
     ASSERT_TRUE(run_->views.count(s)) << "keyframe " << i;
     const auto& revisions = run_->views.at(s);
-    ASSERT_EQ(revisions.size(), 2u) << "keyframe " << i;
-    for (uint32_t rev = 0; rev < 2; ++rev) {
+    ASSERT_EQ(revisions.size(), 3u) << "keyframe " << i;
+    for (uint32_t rev = 0; rev < 3; ++rev) {
       const wild_mvs::DepthView& v = *revisions[rev];
       EXPECT_EQ(static_cast<int>(v.worker_index), KeyframeOwner(s, kWorkers));
       EXPECT_EQ(v.keyframe_id, k.keyframe_id);
       EXPECT_EQ(v.session, k.session);
       EXPECT_EQ(v.revision, rev);
-      EXPECT_EQ(v.final_revision, rev == 1);
+      EXPECT_EQ(v.final_revision, rev == 2);
     }
   }
 }
