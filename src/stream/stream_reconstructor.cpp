@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <unordered_map>
 
 #include "wild_mvs/core/global_view_selection.h"
@@ -496,6 +497,18 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
   bool chosen = false;
   uint32_t chosen_id = 0;
   RevisionStep chosen_step = RevisionStep::kFinal;
+  // Whether keyframe `id` has as many good neighbours over the store as
+  // MPGC asks for (a revision 1 from fewer would be worse than the
+  // preview; the snapshot is made once, when first needed).
+  std::optional<Snapshot> snap;
+  auto enough_neighbors = [&](uint32_t id) {
+    if (!snap) snap = MakeSnapshotLocked();
+    for (size_t i = 0; i < snap->keyframes.size(); ++i)
+      if (snap->keyframes[i]->id == id)
+        return Evaluate(*snap, static_cast<int>(i), false).good >=
+               options_.mvs.mpgc.min_active_views;
+    return false;
+  };
   for (const auto& [id, pending] : unrevised_) {
     // Not before its preview went out (revision 0 comes first).
     if (held_.count(id) || previewing_.count(id)) continue;
@@ -515,12 +528,12 @@ void StreamReconstructor::ScheduleRevisionsLocked(bool idle) {
     bool ready;
     if (early == early_newest_.end()) {
       // Revision 1: matched again once the `lookahead` keyframes after it
-      // exist (neighbours on both sides) and the neighbours of its first
-      // match are matched.
+      // exist (neighbours on both sides), the neighbours of its first
+      // match are matched and it has the neighbours MPGC asks for.
       step = RevisionStep::kEarly;
       ready = static_cast<int64_t>(newest_id) - static_cast<int64_t>(id) >=
                   options_.lookahead &&
-              all_settled(false);
+              all_settled(false) && (idle || enough_neighbors(id));
     } else if (!rematched_.count(id)) {
       // Matched again over a full neighbourhood (revision 1 had fewer
       // keyframes to choose from: a stream's start).

@@ -18,9 +18,10 @@
 // (mvs.ablation.consistency, as offline) that first map is a preview at
 // half the working size, and two revisions follow, same stamp, each a
 // step of the offline pipeline. Revision 1, within `lookahead` keyframes:
-// once the `lookahead` keyframes after it exist and every neighbour it was
+// once the `lookahead` keyframes after it exist, every neighbour it was
 // matched against is done (matched by this worker, owned by another,
-// failed or evicted), it is matched again at the working size over every
+// failed or evicted) and it has mvs.mpgc.min_active_views good
+// neighbours, it is matched again at the working size over every
 // keyframe held, so with neighbours on both sides, checked against the
 // maps its neighbours have then (FilterByConsistency) and delivered.
 // Revision 2, final: the offline filter (FilterByConsistency with
