@@ -710,18 +710,29 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation,
   error = CheckAgainstMaps(mvs, workspace, maps, &result.depth);
   result.revision = 1;
   result.final_revision = false;
+  DeliverRevision(generation, error, result);
+}
+
+void StreamReconstructor::DeliverRevision(uint64_t generation,
+                                          const std::string& error,
+                                          const StreamResult& result) {
+  const uint32_t id = result.keyframe_id;
   bool deliver = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (result.final_revision) unrevised_.erase(id);
     if (generation != generation_) {
       ++stats_.stale_results;
-    } else if (error.empty()) {
-      ++stats_.early_revised;
+    } else if (!error.empty()) {
+      ++stats_.failed;
+    } else {
+      ++(result.final_revision ? stats_.revised : stats_.early_revised);
       deliver = true;
     }
   }
   if (!error.empty() && on_error_)
-    on_error_(Msg("keyframe ", id, ": checking revision 1 failed: ", error));
+    on_error_(Msg("keyframe ", id, ": revision ", result.revision,
+                  " failed: ", error));
   if (deliver && on_result_) on_result_(result);
   std::lock_guard<std::mutex> lock(mutex_);
   EndRevisionStepLocked(id);
@@ -757,24 +768,7 @@ void StreamReconstructor::RunRevisionFilter(uint32_t id, uint64_t generation) {
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
           .count();
-  bool deliver = false;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    unrevised_.erase(id);
-    if (generation != generation_) {
-      ++stats_.stale_results;
-    } else if (!error.empty()) {
-      ++stats_.failed;
-    } else {
-      ++stats_.revised;
-      deliver = true;
-    }
-  }
-  if (!error.empty() && on_error_)
-    on_error_(Msg("keyframe ", id, ": revision failed: ", error));
-  if (deliver && on_result_) on_result_(result);
-  std::lock_guard<std::mutex> lock(mutex_);
-  EndRevisionStepLocked(id);
+  DeliverRevision(generation, error, result);
 }
 
 void StreamReconstructor::Tick() {

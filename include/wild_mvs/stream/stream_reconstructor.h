@@ -338,6 +338,10 @@ class StreamReconstructor {
   void RunRevisionMatch(uint32_t id, uint64_t generation, RevisionStep step,
                         bool idle);
   void RunRevisionFilter(uint32_t id, uint64_t generation);  // kFinal
+  // Hands a revision to the result callback (unless it failed or a Reset
+  // came meanwhile: counted), then schedules the next step.
+  void DeliverRevision(uint64_t generation, const std::string& error,
+                       const StreamResult& result);
   // The store holds as many other keyframes as the view selection picks.
   bool FullStoreLocked() const;
   // No keyframe for idle_flush s and for twice the last keyframe interval.
