@@ -657,7 +657,7 @@ void StreamReconstructor::RunRevisionMatch(uint32_t id, uint64_t generation,
     snap = MakeSnapshotLocked();
     for (size_t i = 0; i < snap.keyframes.size(); ++i)
       if (snap.keyframes[i]->id == id) ref = static_cast<int>(i);
-    if (!snap.keyframes.empty()) newest_id = snap.keyframes.back()->id;
+    if (const KeyframePtr newest = store_.Newest()) newest_id = newest->id;
     full = FullStoreLocked();
     mvs = options_.mvs;
     ++stats_.running;
