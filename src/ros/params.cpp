@@ -309,8 +309,9 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .Min(0);
   registry
       ->Add(key("revision_timeout"), &o->session.revision_timeout,
-            "s a view waits for its keyframe's final revision before it is "
-            "fused as it is (0 = never waits)")
+            "a view waits for its keyframe's final revision until its depth "
+            "session sent nothing for this long (s), then it is fused as it "
+            "is (0 = never waits)")
       .Min(0);
   registry
       ->Add(key("on_new_session"), &o->session.on_new_session,
@@ -320,7 +321,8 @@ void RegisterOptions(OptionRegistry* registry, const std::string& prefix,
       .OneOf({"keep", "reset"});
   registry
       ->Add(key("map_store_mb"), &o->session.map_store_mb,
-            "depth maps kept in memory; older ones spill to spill_dir")
+            "depth maps kept in memory: fused ones beyond it spill to "
+            "spill_dir, waiting ones are fused, oldest first")
       .Above(0);
   registry->Add(key("spill_dir"), &o->session.spill_dir,
                 "\"\" = a temporary folder, removed at exit");

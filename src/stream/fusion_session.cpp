@@ -10,7 +10,19 @@
 
 namespace wild_mvs {
 
+namespace {
+
+size_t ViewBytes(const FusionView& v) {
+  // As DepthMapStore counts a held map: 20 bytes per depth pixel.
+  return v.map.depth.total() * 20 + v.image.total() * v.image.elemSize();
+}
+
+}  // namespace
+
 void ReorderBuffer::Insert(FusionView view) {
+  Clock::time_point& last = last_arrival_[view.session_ns];
+  last = std::max(last, view.arrived);
+  bytes_ += ViewBytes(view);
   const uint64_t key = view.stamp_ns;
   waiting_[key] = std::move(view);
 }
@@ -19,9 +31,32 @@ bool ReorderBuffer::Replace(FusionView view) {
   auto it = waiting_.find(view.stamp_ns);
   if (it == waiting_.end() || view.revision <= it->second.revision)
     return false;
+  Clock::time_point& last = last_arrival_[view.session_ns];
+  last = std::max(last, view.arrived);
   view.arrived = it->second.arrived;
+  bytes_ += ViewBytes(view);
+  bytes_ -= ViewBytes(it->second);
   it->second = std::move(view);
   return true;
+}
+
+void ReorderBuffer::Clear() {
+  waiting_.clear();
+  bytes_ = 0;
+}
+
+bool ReorderBuffer::AwaitsRevision(const FusionView& v,
+                                   Clock::time_point now) const {
+  if (v.final_revision) return false;
+  // A revision never comes once the depth node started another session
+  // (its reset forgets the revisions to come).
+  for (const auto& [key, w] : waiting_)
+    if (w.session_ns != v.session_ns) return false;
+  auto last = last_arrival_.find(v.session_ns);
+  const Clock::time_point since = last == last_arrival_.end()
+                                      ? v.arrived
+                                      : std::max(last->second, v.arrived);
+  return std::chrono::duration<double>(now - since).count() < revision_timeout_;
 }
 
 bool ReorderBuffer::PopReady(Clock::time_point now, FusionView* out) {
@@ -33,16 +68,12 @@ bool ReorderBuffer::PopReady(Clock::time_point now, FusionView* out) {
           ? static_cast<int64_t>(v.keyframe_id) == last_fused_id_ + 1
           : (Seen(v.session_ns) || v.keyframe_id == 0);
   const double waited = std::chrono::duration<double>(now - v.arrived).count();
-  if (!next && waited < timeout_) return false;
-  // A revision never comes once the depth node started another session
-  // (its reset forgets the revisions to come).
-  auto other_session = [&] {
-    for (const auto& [key, w] : waiting_)
-      if (w.session_ns != v.session_ns) return true;
-    return false;
-  };
-  if (!v.final_revision && waited < revision_timeout_ && !other_session())
-    return false;
+  // Over budget, the oldest goes whatever it waits for.
+  if (bytes_ <= max_bytes_) {
+    if (!next && waited < timeout_) return false;
+    if (AwaitsRevision(v, now)) return false;
+  }
+  bytes_ -= ViewBytes(it->second);
   *out = std::move(it->second);
   waiting_.erase(it);
   return true;
@@ -52,7 +83,7 @@ std::vector<FusionView> ReorderBuffer::PopAll() {
   std::vector<FusionView> out;
   out.reserve(waiting_.size());
   for (auto& [key, view] : waiting_) out.push_back(std::move(view));
-  waiting_.clear();
+  Clear();
   return out;
 }
 
@@ -84,7 +115,8 @@ FusionSession::FusionSession(const FusionSessionOptions& options,
       on_drop_(std::move(on_drop)),
       on_log_(std::move(on_log)),
       store_(options.map_store_mb, options.spill_dir),
-      reorder_(options.reorder_timeout, options.revision_timeout) {
+      reorder_(options.reorder_timeout, options.revision_timeout,
+               static_cast<size_t>(options.map_store_mb * 1048576.0)) {
   NewFusionLocked();
   SnapshotLocked();
 }
@@ -172,7 +204,7 @@ void FusionSession::SnapshotLocked() {
   s.resets = resets_;
   s.sessions = sessions_;
   s.session_saves = session_saves_;
-  s.held_mb = store_.bytes() / 1048576.0;
+  s.held_mb = (store_.bytes() + reorder_.bytes()) / 1048576.0;
   s.fusion = fusion_->stats();
   s.fusion_bytes = fusion_->bytes();
   s.last_fuse_seconds = last_fuse_seconds_;

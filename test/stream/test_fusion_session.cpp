@@ -48,8 +48,10 @@ FusionView SceneView(int i, uint64_t session, uint32_t id) {
   return v;
 }
 
+constexpr size_t kNoBudget = size_t(1) << 40;
+
 TEST(ReorderBuffer, ReleasesViewsInKeyframeOrder) {
-  ReorderBuffer b(2.0, 30.0);
+  ReorderBuffer b(2.0, 30.0, kNoBudget);
   const Clock::time_point t0 = Clock::now();
   const uint64_t S = 77;
   FusionView out;
@@ -100,10 +102,10 @@ TEST(ReorderBuffer, ReleasesViewsInKeyframeOrder) {
 }
 
 // A first revision that is not final waits for its final revision, which
-// replaces it, or at most revision_timeout; an earlier revision never
-// replaces a later one.
+// replaces it, or until its session sent nothing for revision_timeout; an
+// earlier revision never replaces a later one.
 TEST(ReorderBuffer, WaitsForTheFinalRevisionAndTakesIt) {
-  ReorderBuffer b(2.0, 30.0);
+  ReorderBuffer b(2.0, 30.0, kNoBudget);
   const Clock::time_point t0 = Clock::now();
   const uint64_t S = 5;
   FusionView out;
@@ -123,12 +125,13 @@ TEST(ReorderBuffer, WaitsForTheFinalRevisionAndTakesIt) {
   EXPECT_EQ(out.arrived, t0);  // the first one's arrival is kept
   b.StartSession(S);
   b.Fused(S, 0);
-  // Keyframe 1's revision never comes: it goes after revision_timeout.
+  // Keyframe 1's revision never comes: it goes once the session sent
+  // nothing for revision_timeout (its last view came at t0 + 10 s).
   FusionView lone = MakeView(S, 1, 101, t0);
   lone.final_revision = false;
   b.Insert(lone);
-  EXPECT_FALSE(b.PopReady(t0 + std::chrono::milliseconds(29999), &out));
-  ASSERT_TRUE(b.PopReady(t0 + std::chrono::seconds(30), &out));
+  EXPECT_FALSE(b.PopReady(t0 + std::chrono::milliseconds(39999), &out));
+  ASSERT_TRUE(b.PopReady(t0 + std::chrono::seconds(40), &out));
   EXPECT_EQ(out.revision, 0);
   b.Fused(S, 1);
   // ... nor once a view of another session waits (the depth node reset).
@@ -139,6 +142,67 @@ TEST(ReorderBuffer, WaitsForTheFinalRevisionAndTakesIt) {
   b.Insert(MakeView(S + 1, 0, 200, t0));
   ASSERT_TRUE(b.PopReady(t0, &out));
   EXPECT_EQ(out.stamp_ns, 102u);
+}
+
+// A slow stream: a keyframe's final revision comes some keyframes later,
+// long after revision_timeout, and the view waits for it as long as its
+// depth node keeps sending (the views behind it wait in stamp order).
+TEST(ReorderBuffer, WaitsForTheFinalRevisionWhileTheSessionSends) {
+  ReorderBuffer b(2.0, 30.0, kNoBudget);
+  const Clock::time_point t0 = Clock::now();
+  const uint64_t S = 9;
+  auto at = [&](int s) { return t0 + std::chrono::seconds(s); };
+  FusionView out;
+  FusionView first = MakeView(S, 0, 100, at(0));
+  first.final_revision = false;
+  b.Insert(first);
+  for (uint32_t k = 1; k <= 15; ++k) {  // a keyframe every 4 s
+    FusionView next = MakeView(S, k, 100 + k, at(4 * k));
+    next.final_revision = false;
+    b.Insert(next);
+    EXPECT_FALSE(b.PopReady(at(4 * k), &out)) << "keyframe " << k;
+  }
+  EXPECT_EQ(b.size(), 16u);
+  FusionView final0 = MakeView(S, 0, 100, at(61));
+  final0.revision = 2;
+  final0.final_revision = true;
+  ASSERT_TRUE(b.Replace(final0));
+  ASSERT_TRUE(b.PopReady(at(61), &out));
+  EXPECT_EQ(out.stamp_ns, 100u);
+  EXPECT_EQ(out.revision, 2);
+  b.StartSession(S);
+  b.Fused(S, 0);
+  // Keyframe 1 still waits; once the stream is silent for revision_timeout
+  // the rest go as they are.
+  EXPECT_FALSE(b.PopReady(at(61 + 29), &out));
+  ASSERT_TRUE(b.PopReady(at(61 + 30), &out));
+  EXPECT_EQ(out.stamp_ns, 101u);
+  EXPECT_EQ(out.revision, 0);
+}
+
+// The waiting views are bounded in memory: beyond the budget the oldest
+// goes as it is, whatever it waits for.
+TEST(ReorderBuffer, WaitingViewsStayWithinTheirBudget) {
+  auto sized = [](uint64_t stamp, uint32_t id, Clock::time_point t) {
+    FusionView v = MakeView(3, id, stamp, t);
+    v.map.depth = cv::Mat(10, 10, CV_32F, cv::Scalar(1));  // 2,000 bytes
+    v.final_revision = false;
+    return v;
+  };
+  ReorderBuffer b(2.0, 30.0, 5000);
+  const Clock::time_point t0 = Clock::now();
+  FusionView out;
+  b.Insert(sized(100, 0, t0));
+  b.Insert(sized(101, 1, t0));
+  EXPECT_EQ(b.bytes(), 4000u);
+  EXPECT_FALSE(b.PopReady(t0, &out));  // within the budget: they wait
+  b.Insert(sized(102, 2, t0));
+  ASSERT_TRUE(b.PopReady(t0, &out));
+  EXPECT_EQ(out.stamp_ns, 100u);
+  EXPECT_EQ(b.bytes(), 4000u);
+  EXPECT_FALSE(b.PopReady(t0, &out));
+  EXPECT_EQ(b.PopAll().size(), 2u);
+  EXPECT_EQ(b.bytes(), 0u);
 }
 
 struct Recorder {

@@ -7,12 +7,14 @@
 // is the next keyframe id of the current session, the first (id 0) of a new
 // session, a late view of a session seen before, or when it waited
 // `reorder_timeout`; a view that is not its keyframe's final revision
-// (FusionView::final_revision) also waits for that revision, at most
-// `revision_timeout` s after it arrived and only while no view of another
-// session waits (a depth node that reset sends no more revisions). A later
-// revision of a waiting view replaces it; a revision of a view fused already is
-// ignored (counted): the fusion is incremental and never takes a view out
-// again.
+// (FusionView::final_revision) also waits for that revision while its depth
+// node is still sending: until `revision_timeout` s passed without a view of
+// its session (a final revision comes some keyframes later, however slowly
+// they come), and only while no view of another session waits (a depth node
+// that reset sends no more revisions) and the waiting views hold less than
+// `map_store_mb` (beyond it the oldest goes as it is). A later revision of a
+// waiting view replaces it; a revision of a view fused already is ignored
+// (counted): the fusion is incremental and never takes a view out again.
 //
 // Sessions (StreamResult::session): the first view of a session not seen
 // before starts it. on_new_session "keep" fuses it into the same cloud;
@@ -59,8 +61,11 @@ struct FusionView {
 class ReorderBuffer {
  public:
   using Clock = std::chrono::steady_clock;
-  ReorderBuffer(double timeout, double revision_timeout)
-      : timeout_(timeout), revision_timeout_(revision_timeout) {}
+  // max_bytes: the waiting views' budget (map and image bytes).
+  ReorderBuffer(double timeout, double revision_timeout, size_t max_bytes)
+      : timeout_(timeout),
+        revision_timeout_(revision_timeout),
+        max_bytes_(max_bytes) {}
 
   bool Contains(uint64_t stamp_ns) const { return waiting_.count(stamp_ns); }
   // Adds a view (its stamp must not be waiting already).
@@ -73,8 +78,9 @@ class ReorderBuffer {
   bool PopReady(Clock::time_point now, FusionView* out);
   // Takes every waiting view, oldest first.
   std::vector<FusionView> PopAll();
-  void Clear() { waiting_.clear(); }
+  void Clear();
   size_t size() const { return waiting_.size(); }
+  size_t bytes() const { return bytes_; }  // held by the waiting views
 
   // The fusing side's progress.
   void StartSession(uint64_t session);  // becomes current, expects id 0
@@ -86,9 +92,17 @@ class ReorderBuffer {
   bool Seen(uint64_t session) const { return seen_sessions_.count(session); }
 
  private:
+  // Whether `v` (waiting) may still wait for its final revision at `now`.
+  bool AwaitsRevision(const FusionView& v, Clock::time_point now) const;
+
   double timeout_;
   double revision_timeout_;
+  size_t max_bytes_;
   std::map<uint64_t, FusionView> waiting_;  // by stamp (ns)
+  size_t bytes_ = 0;
+  // Each session's latest arrival (a view or a revision): its depth node
+  // is still sending.
+  std::map<uint64_t, Clock::time_point> last_arrival_;
   int64_t last_fused_id_ = -1;
   int64_t current_session_ = -1;
   std::set<uint64_t> seen_sessions_;  // every session fused so far
@@ -97,15 +111,17 @@ class ReorderBuffer {
 struct FusionSessionOptions {
   // A view waits at most this long (s, >= 0) for a missing earlier keyframe.
   double reorder_timeout = 2.0;
-  // A view that is not its keyframe's final revision waits at most this
-  // long (s, >= 0) for it; 0 = never waits.
+  // A view that is not its keyframe's final revision waits for it until
+  // this long (s, >= 0) passed without a view of its session; 0 = never
+  // waits.
   double revision_timeout = 30.0;
   // A new session: "keep" = fuse it into the same cloud; "reset" = save the
   // cloud so far (see output_path) and start a new one.
   std::string on_new_session = "keep";
   // Stem of the session saves <stem>_session<N>.ply; "" = none.
   std::string output_path;
-  // Depth maps held in memory (MB, > 0); older ones spill to spill_dir.
+  // Depth maps held in memory (MB, > 0): fused ones beyond it spill to
+  // spill_dir; waiting ones beyond it are fused, oldest first.
   double map_store_mb = 256;
   std::string spill_dir;  // "" = a temporary folder, removed at the end
   FusionOptions fusion;
@@ -121,7 +137,7 @@ struct FusionSessionStats {
   uint64_t resets = 0;              // Reset() calls and session resets
   uint64_t sessions = 0;
   uint64_t session_saves = 0;
-  double held_mb = 0;  // depth maps held in memory
+  double held_mb = 0;  // depth maps held in memory, fused and waiting
   double last_fuse_seconds = 0;
   FusionStats fusion;
   size_t fusion_bytes = 0;
