@@ -637,10 +637,9 @@ def main():
                "how many newer keyframes got their first depth view before a "
                "keyframe's revision 1 (its row) or final revision (median / max). "
                "A final revision waits for a full neighbourhood (10 other keyframes) "
-               "and for its neighbours' final matches; at 0.25 views/s that is more "
-               "than the fusion node's `~revision_timeout` (30 s) for a stream's "
-               "first keyframes, which it then fuses from revision 1: hence the "
-               "lower F there.", ""]
+               "and for its neighbours' final matches (40 s and more at 0.25 "
+               "views/s); the fusion node holds a keyframe's earlier revisions "
+               "for it while the depth node still sends.", ""]
         md += [table(["scene", "seed", "run", "views", "coverage", "within 1 %",
                       "off > 5 %", "F 1 cm", "F 5 cm", "CPU-s", "first depth s",
                       "revised after"],
