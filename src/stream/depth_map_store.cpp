@@ -39,7 +39,7 @@ DepthMapStore::~DepthMapStore() {
 void DepthMapStore::Hold(int v, DepthMap map, cv::Mat image,
                          const ErrorCallback& on_error) {
   Held h;
-  h.bytes = map.depth.total() * 20 + image.total() * image.elemSize();
+  h.bytes = HeldBytes(map, image);
   h.image = std::move(image);
   h.map = std::make_shared<const DepthMap>(std::move(map));
   bytes_ += h.bytes;

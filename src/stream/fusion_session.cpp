@@ -13,8 +13,7 @@ namespace wild_mvs {
 namespace {
 
 size_t ViewBytes(const FusionView& v) {
-  // As DepthMapStore counts a held map: 20 bytes per depth pixel.
-  return v.map.depth.total() * 20 + v.image.total() * v.image.elemSize();
+  return DepthMapStore::HeldBytes(v.map, v.image);
 }
 
 }  // namespace
@@ -52,10 +51,8 @@ bool ReorderBuffer::AwaitsRevision(const FusionView& v,
   // (its reset forgets the revisions to come).
   for (const auto& [key, w] : waiting_)
     if (w.session_ns != v.session_ns) return false;
-  auto last = last_arrival_.find(v.session_ns);
-  const Clock::time_point since = last == last_arrival_.end()
-                                      ? v.arrived
-                                      : std::max(last->second, v.arrived);
+  // Insert recorded v's session (and its arrival) before v could wait.
+  const Clock::time_point since = last_arrival_.at(v.session_ns);
   return std::chrono::duration<double>(now - since).count() < revision_timeout_;
 }
 

@@ -54,6 +54,10 @@ class DepthMapStore {
   void Clear();
 
   size_t bytes() const { return bytes_; }  // held in memory (estimate)
+  // The estimate of one view: 20 bytes per depth pixel plus the image.
+  static size_t HeldBytes(const DepthMap& map, const cv::Mat& image) {
+    return map.depth.total() * 20 + image.total() * image.elemSize();
+  }
   uint64_t spilled() const { return spilled_; }
   const std::string& dir() const { return dir_; }
   static std::string Stem(int v) { return "view_" + std::to_string(v); }
