@@ -427,6 +427,9 @@ def main():
     readme = []
     peers_dir = os.path.join(root, "bench", "peers")
 
+    def ran_here(p):  # a peer's figures column when it ran beside wild_mvs
+        return f"run here: {p['source']}" if p.get("source") else "run here"
+
     # --- speed -------------------------------------------------------------
     def state(name):  # what an absent section's table says
         return "Failed in this run." if name in failed else "Not run."
@@ -448,7 +451,7 @@ def main():
         for p in ran:
             rows.append([p["system"], p["size"], plain(p["cpu_s"]), count(p["samples"]),
                          count(p["correct"]), kilo(p["correct_per_cpu_s"]),
-                         plain(p["peak_rss_mb"], "{:.0f}"), "run here"])
+                         plain(p["peak_rss_mb"], "{:.0f}"), ran_here(p)])
         for p in read_tsv(os.path.join(peers_dir, "speed_temple.tsv")):
             if p["system"] in ran_names:
                 continue
@@ -485,7 +488,7 @@ def main():
         rows = [frow("wild_mvs", f, "run here (depth + fusion)")]
         ran = read_tsv(os.path.join(out, "peers", "fountain.tsv")) or []
         ran_names = {p["system"] for p in ran}
-        rows += [frow(p["system"], p, "run here") for p in ran]
+        rows += [frow(p["system"], p, ran_here(p)) for p in ran]
         rows += [frow(p["system"], p, f"recorded, not run here: {p['source']}")
                  for p in read_tsv(os.path.join(peers_dir, "fountain.tsv"))
                  if p["system"] not in ran_names]

@@ -30,9 +30,11 @@
 #             images (relief and courtyard light, seed 101); needs the ROS
 #             build in build/ (scripts/run_tests.sh makes it), else not run.
 # Peers: with OPENMVS_BIN (the folder of OpenMVS's InterfaceCOLMAP and
-# DensifyPointCloud) OpenMVS runs beside wild_mvs (full setting only);
-# otherwise, and for MVE (no runner here), RESULTS.md shows their recorded
-# figures (bench/peers/*.tsv), marked "recorded, not run here".
+# DensifyPointCloud) OpenMVS runs beside wild_mvs on templeSparseRing
+# (bench/run_openmvs.sh), with MVE_BIN (the folder of MVE's dmrecon) MVE
+# runs beside it on templeSparseRing and fountain-P11 (bench/run_mve.sh),
+# full setting only; otherwise RESULTS.md shows their recorded figures
+# (bench/peers/*.tsv), marked "recorded, not run here".
 #
 # Usage: bench/run_all.sh [--quick] [--skip LIST] [--threads N] [--out DIR]
 #                         [--skip-build]
@@ -46,8 +48,7 @@
 #   --out DIR    raw outputs (default bench/out/all-<UTC time>, ignored by git)
 # Environment: WILD_MVS_DATASETS (default ../shared/datasets of the repo;
 # fountain needs it, temple uses its GT model when present), BUILD_DIR
-# (default build-bench), OPENMVS_BIN. (MVE: recorded figures only; no
-# runner for dmrecon and its .mvei depth maps yet.)
+# (default build-bench), OPENMVS_BIN, MVE_BIN.
 # Installs what it needs (scripts/install_deps.sh --no-ros --tests --bench: the
 # build dependencies, time, bc, python3-matplotlib) unless --skip-build.
 set -euo pipefail
@@ -190,9 +191,22 @@ if ! skipped live; then
 fi
 
 # Peers beside wild_mvs, where their binaries are given (full setting only:
-# their recorded figures are at the full sizes). MVE has no runner here.
-[ -z "${MVE_BIN:-}" ] ||
-  echo "run_all.sh: MVE_BIN is set, but there is no MVE runner here; RESULTS.md shows MVE's recorded figures" >&2
+# their recorded figures are at the full sizes). Each adds its rows to
+# OUT/peers/speed_temple.tsv and fountain.tsv (add_peer_rows).
+add_peer_rows() {  # SRC_TSV DST_TSV: SRC's rows (and header if DST is new)
+  if [ -f "$2" ]; then tail -n +2 "$1" >>"$2"; else cp "$1" "$2"; fi
+}
+if [ -n "${MVE_BIN:-}" ] && [ "$QUICK" = 0 ]; then
+  mkdir -p "$OUT/peers"
+  if MVE_BIN="$MVE_BIN" WILD_MVS_BIN="$BUILD_DIR/bin" bash "$ROOT/bench/run_mve.sh" \
+    --threads "$THREADS" --out "$OUT/mve"; then
+    for t in speed_temple fountain; do
+      add_peer_rows "$OUT/mve/peers/$t.tsv" "$OUT/peers/$t.tsv"
+    done
+  else
+    echo "run_all.sh: bench/run_mve.sh failed; RESULTS.md shows MVE's recorded figures" >&2
+  fi
+fi
 if [ -n "${OPENMVS_BIN:-}" ] && [ "$QUICK" = 0 ]; then
   WILD_MVS_BIN="$BUILD_DIR/bin" bash "$ROOT/bench/run_openmvs.sh" --threads "$THREADS" \
     --out "$OUT/openmvs" --cloud
@@ -206,8 +220,11 @@ t = open(os.path.join(src, "temple", "summary.txt")).read().splitlines()
 cpu = re.search(r"DensifyPointCloud ([\d.]+) CPU-s", t[0]).group(1)
 rss = re.search(r"peak RSS (\d+) MB", t[0]).group(1)
 s = kv(t[1])
-with open(os.path.join(dst, "speed_temple.tsv"), "w") as f:
-    f.write("system\tsize\tcpu_s\tsamples\tcorrect\tcorrect_per_cpu_s\tpeak_rss_mb\n")
+path = os.path.join(dst, "speed_temple.tsv")
+new = not os.path.exists(path)
+with open(path, "a") as f:
+    if new:
+        f.write("system\tsize\tcpu_s\tsamples\tcorrect\tcorrect_per_cpu_s\tpeak_rss_mb\n")
     f.write(f"OpenMVS DensifyPointCloud\t640\t{cpu}\t{s['samples']}\t{s['correct']}\t"
             f"{s['correct_per_cpu_s']}\t{rss}\n")
 PY
