@@ -28,6 +28,9 @@ import os
 import struct
 import sys
 
+import wild_mvs_folder
+from wild_mvs_folder import write_pfm
+
 HAS_NORMAL, HAS_CONF, HAS_VIEWS = 2, 4, 8
 
 
@@ -81,24 +84,6 @@ def stem_of(image):
     return stem.replace(" ", "_")
 
 
-def write_atomic(path, blob):
-    tmp = path + ".tmp"
-    with open(tmp, "wb") as f:
-        f.write(blob)
-    os.replace(tmp, path)
-
-
-def write_pfm(path, values, w, h):
-    # Little endian (scale -1), bottom row first.
-    v = array.array("f", values)
-    if sys.byteorder != "little":
-        v.byteswap()
-    raw = v.tobytes()
-    row = 4 * w
-    body = b"".join(raw[r * row:(r + 1) * row] for r in range(h - 1, -1, -1))
-    write_atomic(path, b"Pf\n%d %d\n-1\n" % (w, h) + body)
-
-
 def camera_text(d, neighbours):
     K, R, C = d["K"], d["R"], d["C"]
     sx, sy = d["w"] / d["iw"], d["h"] / d["ih"]
@@ -106,17 +91,8 @@ def camera_text(d, neighbours):
     cx, cy = (K[2] + 0.5) * sx, (K[5] + 0.5) * sy
     t = [-(R[3 * r] * C[0] + R[3 * r + 1] * C[1] + R[3 * r + 2] * C[2])
          for r in range(3)]
-    g = lambda x: repr(float(x))
-    lines = ["# wild_mvs depth map camera (converted from an OpenMVS .dmap): "
-             "width height / fx fy cx cy / R (3 rows, world-to-camera) / t / "
-             "N / N neighbour names",
-             f"{d['w']} {d['h']}", f"{g(fx)} {g(fy)} {g(cx)} {g(cy)}"]
-    for r in range(3):
-        lines.append(" ".join(g(R[3 * r + k]) for k in range(3)))
-    lines.append(" ".join(g(x) for x in t))
-    lines.append(str(len(neighbours)))
-    lines += neighbours
-    return ("\n".join(lines) + "\n").encode()
+    return wild_mvs_folder.camera_text("an OpenMVS .dmap", d["w"], d["h"],
+                                       fx, fy, cx, cy, R, t, neighbours)
 
 
 def main(argv):
@@ -144,8 +120,7 @@ def main(argv):
             write_pfm(os.path.join(out, "confidence", s + ".pfm"), d["conf"],
                       d["w"], d["h"])
         nb = [names[i] for i in d["ids"][1:] if i in names]
-        # The camera last, as wild_mvs does: its presence marks a finished view.
-        write_atomic(os.path.join(out, "cameras", s + ".txt"), camera_text(d, nb))
+        wild_mvs_folder.write_camera(out, s, camera_text(d, nb))
         print(f"{os.path.basename(p)} -> {s}: {d['w']}x{d['h']} "
               f"(image {d['iw']}x{d['ih']}), {valid} samples, "
               f"depth {d['dmin']:.4g}..{d['dmax']:.4g}, {len(d['ids']) - 1} neighbours")

@@ -39,6 +39,9 @@ import shutil
 import struct
 import sys
 
+import wild_mvs_folder
+from wild_mvs_folder import write_pfm
+
 MVEI_SIGNATURE = b"\x89MVE_IMAGE\n"
 MVEI_FLOAT = 9
 
@@ -187,23 +190,6 @@ def read_mvei(path):
     return w, h, v
 
 
-def write_atomic(path, blob):
-    tmp = path + ".tmp"
-    with open(tmp, "wb") as f:
-        f.write(blob)
-    os.replace(tmp, path)
-
-
-def write_pfm(path, values, w, h):
-    # Little endian (scale -1), bottom row first.
-    if sys.byteorder != "little":
-        values.byteswap()
-    raw = values.tobytes()
-    row = 4 * w
-    body = b"".join(raw[r * row:(r + 1) * row] for r in range(h - 1, -1, -1))
-    write_atomic(path, b"Pf\n%d %d\n-1\n" % (w, h) + body)
-
-
 def to_wild_mvs(scene, embedding, out):
     views = os.path.join(scene, "views")
     for sub in ("depth", "cameras"):
@@ -237,17 +223,11 @@ def to_wild_mvs(scene, embedding, out):
                     valid += 1
         stem = meta["view.name"].replace(" ", "_")
         write_pfm(os.path.join(out, "depth", stem + ".pfm"), z, w, h)
-        g = lambda v: repr(float(v))
-        rot = meta["camera.rotation"].split()
-        cam = ["# wild_mvs depth map camera (converted from an MVE view): "
-               "width height / fx fy cx cy / R (3 rows, world-to-camera) / t / "
-               "N / N neighbour names",
-               f"{w} {h}", f"{g(fx)} {g(fy)} {g(cx)} {g(cy)}",
-               " ".join(rot[0:3]), " ".join(rot[3:6]), " ".join(rot[6:9]),
-               meta["camera.translation"], "0"]
-        # The camera last, as wild_mvs does: its presence marks a finished view.
-        write_atomic(os.path.join(out, "cameras", stem + ".txt"),
-                     ("\n".join(cam) + "\n").encode())
+        text = wild_mvs_folder.camera_text(
+            "an MVE view", w, h, fx, fy, cx, cy,
+            meta["camera.rotation"].split(), meta["camera.translation"].split(),
+            [])
+        wild_mvs_folder.write_camera(out, stem, text)
         print(f"{d} -> {stem}: {w}x{h}, {valid} samples")
         total += valid
         n += 1
