@@ -210,24 +210,24 @@ fi
 if [ -n "${OPENMVS_BIN:-}" ] && [ "$QUICK" = 0 ]; then
   WILD_MVS_BIN="$BUILD_DIR/bin" bash "$ROOT/bench/run_openmvs.sh" --threads "$THREADS" \
     --out "$OUT/openmvs" --cloud
-  "$PY" - "$OUT/openmvs" "$OUT/peers" <<'PY'
+  "$PY" - "$OUT/openmvs" "$THREADS" <<'PY'
 import os, re, sys
-src, dst = sys.argv[1:]
-os.makedirs(dst, exist_ok=True)
+src, threads = sys.argv[1:]
 def kv(line):
     return dict(re.findall(r"(\w[\w.]*)=([^\s]+)", line))
 t = open(os.path.join(src, "temple", "summary.txt")).read().splitlines()
 cpu = re.search(r"DensifyPointCloud ([\d.]+) CPU-s", t[0]).group(1)
 rss = re.search(r"peak RSS (\d+) MB", t[0]).group(1)
 s = kv(t[1])
-path = os.path.join(dst, "speed_temple.tsv")
-new = not os.path.exists(path)
-with open(path, "a") as f:
-    if new:
-        f.write("system\tsize\tcpu_s\tsamples\tcorrect\tcorrect_per_cpu_s\tpeak_rss_mb\n")
+os.makedirs(os.path.join(src, "peers"), exist_ok=True)
+with open(os.path.join(src, "peers", "speed_temple.tsv"), "w") as f:
+    f.write("system\tsize\tcpu_s\tsamples\tcorrect\tcorrect_per_cpu_s\tpeak_rss_mb\tsource\n")
     f.write(f"OpenMVS DensifyPointCloud\t640\t{cpu}\t{s['samples']}\t{s['correct']}\t"
-            f"{s['correct_per_cpu_s']}\t{rss}\n")
+            f"{s['correct_per_cpu_s']}\t{rss}\t"
+            f"bench/run_openmvs.sh, default options, {threads} threads, one run\n")
 PY
+  mkdir -p "$OUT/peers"
+  add_peer_rows "$OUT/openmvs/peers/speed_temple.tsv" "$OUT/peers/speed_temple.tsv"
 fi
 
 {

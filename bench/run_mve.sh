@@ -129,11 +129,10 @@ if [ -z "$ONLY" ] || [ "$ONLY" = fountain ]; then
   "$WILD_MVS_BIN/wild_mvs" eval depth --est "$W" --dataset "$F" \
     --rel-thresholds 0.01,0.05 --json "$OUT/fountain/eval_depth.json" \
     >"$OUT/fountain/eval_depth.txt"
-  python3 - "$OUT/fountain/eval_depth.json" "$cpu" "$rss" 1 "$OUT/peers/fountain.tsv" "$THREADS" <<'EOF' | tee "$OUT/fountain/summary.txt"
+  python3 - "$OUT/fountain/eval_depth.json" "$cpu" "$rss" "$OUT/peers/fountain.tsv" "$THREADS" <<'EOF' | tee "$OUT/fountain/summary.txt"
 import json, sys
 j = json.load(open(sys.argv[1]))
-cpu, rss, runs, tsv, threads = (float(sys.argv[2]), sys.argv[3], sys.argv[4],
-                                 sys.argv[5], sys.argv[6])
+cpu, rss, tsv, threads = float(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5]
 est = max(1, j["estimated"])
 off5 = 1 - j["relative_accuracy"][1]
 print(f"fountain: dmrecon {cpu:.1f} CPU-s (one run), peak RSS {rss} MB")
